@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs what crowdslam needs from Debian 12 packages (only what is missing), then configures and
+# builds it. Idempotent: a second run with nothing changed only runs the (no-op) incremental build.
+#   scripts/setup.sh [BUILD_DIR] [extra cmake args...]
+# Environment: CROWDSLAM_BUILD_TYPE (default Release), CROWDSLAM_JOBS (default: number of cores).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir="${1:-build}"
+shift || true
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libopencv-dev libeigen3-dev libceres-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=()
+  if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+jobs="${CROWDSLAM_JOBS:-$(nproc)}"
+if [[ ! -f "$build_dir/build.ninja" ]]; then
+  cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${CROWDSLAM_BUILD_TYPE:-Release}" "$@"
+fi
+cmake --build "$build_dir" -j "$jobs"

@@ -1,0 +1,68 @@
+#include "crowdslam/util/text.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <fstream>
+
+#include "crowdslam/util/error.h"
+
+namespace crowdslam {
+
+std::vector<std::string> split_fields(std::string_view line, bool commas_too) {
+  std::vector<std::string> fields;
+  std::string current;
+  for (char c : line) {
+    const bool separator = c == ' ' || c == '\t' || c == '\r' || c == '\n' || (commas_too && c == ',');
+    if (separator) {
+      if (!current.empty()) fields.push_back(std::move(current));
+      current.clear();
+    } else {
+      current.push_back(c);
+    }
+  }
+  if (!current.empty()) fields.push_back(std::move(current));
+  return fields;
+}
+
+std::optional<double> parse_double(std::string_view text) {
+  const std::string s(trim(text));
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(s.c_str(), &end);
+  if (end != s.c_str() + s.size()) return std::nullopt;
+  return value;
+}
+
+std::optional<long long> parse_int(std::string_view text) {
+  const std::string s(trim(text));
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const long long value = std::strtoll(s.c_str(), &end, 10);
+  if (end != s.c_str() + s.size() || errno == ERANGE) return std::nullopt;
+  return value;
+}
+
+std::vector<std::string> read_lines(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw input_error(path, "cannot open file");
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines.push_back(std::move(line));
+  }
+  if (in.bad()) throw input_error(path, "read error");
+  return lines;
+}
+
+std::string trim(std::string_view text) {
+  size_t begin = 0;
+  size_t end = text.size();
+  while (begin < end && (text[begin] == ' ' || text[begin] == '\t' || text[begin] == '\r' || text[begin] == '\n')) ++begin;
+  while (end > begin && (text[end - 1] == ' ' || text[end - 1] == '\t' || text[end - 1] == '\r' || text[end - 1] == '\n')) --end;
+  return std::string(text.substr(begin, end - begin));
+}
+
+}  // namespace crowdslam

@@ -1,0 +1,43 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
+#include "test_support.h"
+
+using namespace crowdslam;
+
+TEST(Text, SplitFieldsDropsEmptyAndHandlesCommasTabs) {
+  const auto f = split_fields(" 1.5,\t2  ,3\r");
+  ASSERT_EQ(f.size(), 3u);
+  EXPECT_EQ(f[0], "1.5");
+  EXPECT_EQ(f[2], "3");
+  EXPECT_EQ(split_fields("a,b", false).size(), 1u);
+}
+
+TEST(Text, ParseDoubleIsStrict) {
+  EXPECT_DOUBLE_EQ(*parse_double("1548339819.87426"), 1548339819.87426);
+  EXPECT_FALSE(parse_double("1.5abc").has_value());
+  EXPECT_FALSE(parse_double("").has_value());
+  EXPECT_TRUE(std::isnan(*parse_double("nan")));
+  EXPECT_EQ(*parse_int(" 42 "), 42);
+  EXPECT_FALSE(parse_int("4.2").has_value());
+}
+
+TEST(Text, ReadLinesMissingFileNamesTheFile) {
+  try {
+    read_lines("/nonexistent/list.txt");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/list.txt"), std::string::npos);
+  }
+}
+
+TEST(Text, ReadLinesStripsCarriageReturns) {
+  test::TempDir tmp;
+  test::write_text(tmp / "a.txt", "x\r\ny\n");
+  const auto lines = read_lines((tmp / "a.txt").string());
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "x");
+}
