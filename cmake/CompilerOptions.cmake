@@ -18,9 +18,13 @@ endif()
 
 # Helper: a library target for one folder of src/crowdslam.
 #   crowdslam_add_library(NAME io SOURCES a.cpp b.cpp DEPS crowdslam_util OpenCV...)
+#   Without SOURCES, every *.cpp in the calling folder is compiled (CONFIGURE_DEPENDS glob).
 function(crowdslam_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS" ${ARGN})
   set(target crowdslam_${ARG_NAME})
+  if(NOT ARG_SOURCES)
+    file(GLOB ARG_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  endif()
   if(ARG_SOURCES)
     add_library(${target} STATIC ${ARG_SOURCES})
     target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
@@ -36,12 +40,18 @@ endfunction()
 
 # Helper: one GoogleTest executable per module, registered with CTest.
 #   crowdslam_add_test(NAME io SOURCES test_x.cpp DEPS crowdslam::io LABELS unit)
+#   Without SOURCES, every test_*.cpp in the calling folder.
 function(crowdslam_add_test)
   cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS;LABELS" ${ARGN})
   set(target test_${ARG_NAME})
+  if(NOT ARG_SOURCES)
+    file(GLOB ARG_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp)
+  endif()
+  if(NOT ARG_SOURCES)
+    return()
+  endif()
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} crowdslam_test_support GTest::gtest_main)
   crowdslam_target_options(${target})
-  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_NAME};${ARG_LABELS}"
-)
+  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_NAME};${ARG_LABELS}")
 endfunction()

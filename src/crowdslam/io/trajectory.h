@@ -1,0 +1,36 @@
+#pragma once
+// Trajectory files: TUM (timestamp tx ty tz qx qy qz qw), KITTI (3x4 row-major per line, no stamps)
+// and EuRoC csv (timestamp in ns, p_x p_y p_z, q_w q_x q_y q_z).
+//
+// Poses are world_from_cam (the camera's pose in the world), as in all three formats.
+#include <string>
+#include <vector>
+
+#include "crowdslam/geometry/se3.h"
+
+namespace crowdslam::io {
+
+struct StampedPose {
+  double timestamp_s = 0.0;
+  geometry::SE3 world_from_cam;
+};
+using Trajectory = std::vector<StampedPose>;
+
+enum class TrajectoryFormat { kTum, kKitti, kEuroc };
+
+// Readers throw InputError naming file and line for malformed lines. TUM reading keeps the file's order.
+Trajectory read_tum_trajectory(const std::string& path);
+// KITTI files have no stamps: timestamps are taken from `timestamps` when given (must match in count),
+// else the line index.
+Trajectory read_kitti_trajectory(const std::string& path, const std::vector<double>& timestamps = {});
+Trajectory read_euroc_trajectory(const std::string& path);
+// Picks the reader by content (EuRoC: ns stamps and commas; KITTI: 12 fields; TUM: 8 fields).
+Trajectory read_trajectory(const std::string& path);
+
+// Writers are atomic (util/atomic_file.h). TUM: timestamp with 6 decimals, pose values with 9.
+void write_tum_trajectory(const std::string& path, const Trajectory& trajectory);
+void write_kitti_trajectory(const std::string& path, const Trajectory& trajectory);
+void write_euroc_trajectory(const std::string& path, const Trajectory& trajectory);
+void write_trajectory(const std::string& path, const Trajectory& trajectory, TrajectoryFormat format);
+
+}  // namespace crowdslam::io
