@@ -1,0 +1,266 @@
+#include "crowdslam/map/map_point.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "crowdslam/feature/descriptor.h"
+#include "crowdslam/map/keyframe.h"
+
+namespace crowdslam::map {
+
+MapPoint::MapPoint(uint64_t id_in, const geometry::Vec3& world, const std::shared_ptr<KeyFrame>& reference_keyframe,
+                   uint64_t first_frame_id_in)
+    : id(id_in),
+      first_keyframe_id(reference_keyframe ? reference_keyframe->id : 0),
+      first_frame_id(first_frame_id_in),
+      world_(world),
+      reference_keyframe_(reference_keyframe) {}
+
+geometry::Vec3 MapPoint::world() const {
+  std::lock_guard lock(position_mutex_);
+  return world_;
+}
+
+void MapPoint::set_world(const geometry::Vec3& world) {
+  std::lock_guard lock(position_mutex_);
+  world_ = world;
+}
+
+geometry::Vec3 MapPoint::normal() const {
+  std::lock_guard lock(position_mutex_);
+  return normal_;
+}
+
+float MapPoint::min_distance() const {
+  std::lock_guard lock(position_mutex_);
+  return 0.8f * min_distance_;
+}
+
+float MapPoint::max_distance() const {
+  std::lock_guard lock(position_mutex_);
+  return 1.2f * max_distance_;
+}
+
+int MapPoint::predict_scale(float distance, const ScaleLevels& levels) const {
+  float ratio = 0;
+  {
+    std::lock_guard lock(position_mutex_);
+    ratio = max_distance_ / std::max(distance, 1e-6f);
+  }
+  int level = static_cast<int>(std::ceil(std::log(ratio) / levels.log_scale_factor));
+  return std::clamp(level, 0, levels.num_levels - 1);
+}
+
+void MapPoint::add_observation(const std::shared_ptr<KeyFrame>& keyframe, size_t index) {
+  std::lock_guard lock(features_mutex_);
+  if (observations_.count(keyframe->id)) return;
+  observations_[keyframe->id] = {keyframe, index};
+  num_observations_ += keyframe->features->has_right(index) ? 2 : 1;
+}
+
+void MapPoint::erase_observation(uint64_t keyframe_id) {
+  bool now_bad = false;
+  {
+    std::lock_guard lock(features_mutex_);
+    auto it = observations_.find(keyframe_id);
+    if (it == observations_.end()) return;
+    auto kf = it->second.keyframe.lock();
+    const bool stereo = kf && kf->features->has_right(it->second.index);
+    num_observations_ -= stereo ? 2 : 1;
+    observations_.erase(it);
+    auto ref = reference_keyframe_.lock();
+    if ((!ref || ref->id == keyframe_id) && !observations_.empty()) {
+      reference_keyframe_ = observations_.begin()->second.keyframe;
+    }
+    now_bad = num_observations_ <= 2;
+  }
+  if (now_bad) set_bad();
+}
+
+std::map<uint64_t, MapPoint::Observation> MapPoint::observations() const {
+  std::lock_guard lock(features_mutex_);
+  return observations_;
+}
+
+int MapPoint::num_observations() const {
+  std::lock_guard lock(features_mutex_);
+  return num_observations_;
+}
+
+bool MapPoint::is_observed_by(uint64_t keyframe_id) const {
+  std::lock_guard lock(features_mutex_);
+  return observations_.count(keyframe_id) > 0;
+}
+
+long MapPoint::index_in(uint64_t keyframe_id) const {
+  std::lock_guard lock(features_mutex_);
+  auto it = observations_.find(keyframe_id);
+  return it == observations_.end() ? -1 : static_cast<long>(it->second.index);
+}
+
+std::shared_ptr<KeyFrame> MapPoint::reference_keyframe() const {
+  std::lock_guard lock(features_mutex_);
+  return reference_keyframe_.lock();
+}
+
+Descriptor MapPoint::descriptor() const {
+  std::lock_guard lock(features_mutex_);
+  return descriptor_;
+}
+
+void MapPoint::compute_distinctive_descriptor() {
+  std::vector<const uint8_t*> descriptors;
+  std::vector<std::shared_ptr<KeyFrame>> keep_alive;
+  for (const auto& [kf_id, obs] : observations()) {
+    auto kf = obs.keyframe.lock();
+    if (!kf || kf->is_bad()) continue;
+    descriptors.push_back(kf->features->descriptor(obs.index));
+    keep_alive.push_back(std::move(kf));
+  }
+  if (descriptors.empty()) return;
+  const size_t n = descriptors.size();
+  std::vector<int> distances(n * n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      const int d = feature::hamming_distance(descriptors[i], descriptors[j]);
+      distances[i * n + j] = d;
+      distances[j * n + i] = d;
+    }
+  }
+  // The descriptor with the least median distance to all others.
+  int best_median = std::numeric_limits<int>::max();
+  size_t best = 0;
+  std::vector<int> row(n);
+  for (size_t i = 0; i < n; ++i) {
+    std::copy(distances.begin() + static_cast<long>(i * n), distances.begin() + static_cast<long>((i + 1) * n),
+              row.begin());
+    std::nth_element(row.begin(), row.begin() + static_cast<long>((n - 1) / 2), row.end());
+    const int median = row[(n - 1) / 2];
+    if (median < best_median) {
+      best_median = median;
+      best = i;
+    }
+  }
+  std::lock_guard lock(features_mutex_);
+  std::copy(descriptors[best], descriptors[best] + 32, descriptor_.begin());
+}
+
+void MapPoint::update_normal_and_depth() {
+  std::map<uint64_t, Observation> obs;
+  std::shared_ptr<KeyFrame> reference;
+  {
+    std::lock_guard lock(features_mutex_);
+    if (bad_) return;
+    obs = observations_;
+    reference = reference_keyframe_.lock();
+  }
+  if (obs.empty() || !reference) return;
+  const geometry::Vec3 position = world();
+  geometry::Vec3 normal_sum = geometry::Vec3::Zero();
+  int count = 0;
+  for (const auto& [kf_id, o] : obs) {
+    auto kf = o.keyframe.lock();
+    if (!kf) continue;
+    normal_sum += (position - kf->camera_center()).normalized();
+    ++count;
+  }
+  if (count == 0) return;
+  const long ref_index = index_in(reference->id);
+  if (ref_index < 0) return;
+  const float distance = static_cast<float>((position - reference->camera_center()).norm());
+  const int level = reference->features->keys_un[static_cast<size_t>(ref_index)].octave;
+  const float level_scale = reference->levels->scale[level];
+  const float top_scale = reference->levels->scale[reference->levels->num_levels - 1];
+  std::lock_guard lock(position_mutex_);
+  max_distance_ = distance * level_scale;
+  min_distance_ = max_distance_ / top_scale;
+  normal_ = normal_sum / count;
+  normal_.normalize();
+}
+
+void MapPoint::increase_visible(int n) {
+  std::lock_guard lock(features_mutex_);
+  visible_ += n;
+}
+
+void MapPoint::increase_found(int n) {
+  std::lock_guard lock(features_mutex_);
+  found_ += n;
+}
+
+float MapPoint::found_ratio() const {
+  std::lock_guard lock(features_mutex_);
+  return static_cast<float>(found_) / static_cast<float>(std::max(1, visible_));
+}
+
+int MapPoint::visible_count() const {
+  std::lock_guard lock(features_mutex_);
+  return visible_;
+}
+
+int MapPoint::found_count() const {
+  std::lock_guard lock(features_mutex_);
+  return found_;
+}
+
+bool MapPoint::is_bad() const {
+  std::lock_guard lock(features_mutex_);
+  return bad_;
+}
+
+void MapPoint::set_bad() {
+  std::map<uint64_t, Observation> obs;
+  {
+    std::lock_guard lock(features_mutex_);
+    if (bad_) return;
+    bad_ = true;
+    obs.swap(observations_);
+    num_observations_ = 0;
+  }
+  for (const auto& [kf_id, o] : obs) {
+    if (auto kf = o.keyframe.lock()) {
+      // Only clear the slot if it still holds this point (it may have been replaced meanwhile).
+      auto current = kf->map_point(o.index);
+      if (current.get() == this) kf->erase_map_point(o.index);
+    }
+  }
+}
+
+void MapPoint::replace(const std::shared_ptr<MapPoint>& other) {
+  if (!other || other.get() == this) return;
+  std::map<uint64_t, Observation> obs;
+  int visible = 0;
+  int found = 0;
+  {
+    std::lock_guard lock(features_mutex_);
+    if (bad_) return;
+    bad_ = true;
+    obs.swap(observations_);
+    num_observations_ = 0;
+    visible = visible_;
+    found = found_;
+    replaced_by_ = other;
+  }
+  for (const auto& [kf_id, o] : obs) {
+    auto kf = o.keyframe.lock();
+    if (!kf) continue;
+    if (!other->is_observed_by(kf_id)) {
+      kf->replace_map_point(o.index, other);
+      other->add_observation(kf, o.index);
+    } else {
+      auto current = kf->map_point(o.index);
+      if (current.get() == this) kf->erase_map_point(o.index);
+    }
+  }
+  other->increase_found(found);
+  other->increase_visible(visible);
+  other->compute_distinctive_descriptor();
+}
+
+std::shared_ptr<MapPoint> MapPoint::replaced_by() const {
+  std::lock_guard lock(features_mutex_);
+  return replaced_by_.lock();
+}
+
+}  // namespace crowdslam::map

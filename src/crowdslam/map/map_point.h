@@ -1,0 +1,90 @@
+#pragma once
+// A 3D landmark. Shared (std::shared_ptr) between the map, keyframes and the current frame; its links back
+// to keyframes are weak, so culling a keyframe frees it. Thread-safe: see docs/ARCHITECTURE.md "Locking".
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+
+#include "crowdslam/geometry/se3.h"
+#include "crowdslam/map/scale_levels.h"
+
+namespace crowdslam::map {
+
+class KeyFrame;
+
+using Descriptor = std::array<uint8_t, 32>;
+
+class MapPoint {
+ public:
+  struct Observation {
+    std::weak_ptr<KeyFrame> keyframe;
+    size_t index = 0;  // keypoint index in that keyframe
+  };
+
+  MapPoint(uint64_t id, const geometry::Vec3& world, const std::shared_ptr<KeyFrame>& reference_keyframe,
+           uint64_t first_frame_id);
+
+  const uint64_t id;
+  const uint64_t first_keyframe_id;
+  const uint64_t first_frame_id;
+
+  // Position and viewing geometry.
+  [[nodiscard]] geometry::Vec3 world() const;
+  void set_world(const geometry::Vec3& world);
+  [[nodiscard]] geometry::Vec3 normal() const;  // mean viewing direction (unit)
+  [[nodiscard]] float min_distance() const;     // scale-invariance range (0.8 * min, 1.2 * max as ORB-SLAM)
+  [[nodiscard]] float max_distance() const;
+  // Pyramid level at which the point is expected to be seen from `distance` metres away.
+  [[nodiscard]] int predict_scale(float distance, const ScaleLevels& levels) const;
+
+  // Observations (keyframe id -> keypoint index).
+  void add_observation(const std::shared_ptr<KeyFrame>& keyframe, size_t index);
+  // When two or fewer observations remain the point is set bad (and so unlinked from its keyframes).
+  void erase_observation(uint64_t keyframe_id);
+  [[nodiscard]] std::map<uint64_t, Observation> observations() const;
+  [[nodiscard]] int num_observations() const;  // a stereo/RGB-D observation counts twice (ORB-SLAM)
+  [[nodiscard]] bool is_observed_by(uint64_t keyframe_id) const;
+  [[nodiscard]] long index_in(uint64_t keyframe_id) const;  // -1 if not observed
+  [[nodiscard]] std::shared_ptr<KeyFrame> reference_keyframe() const;
+
+  // Descriptor: the observation descriptor with the least median distance to the others.
+  [[nodiscard]] Descriptor descriptor() const;
+  void compute_distinctive_descriptor();
+  // Mean normal and scale-invariance distances from the current observations.
+  void update_normal_and_depth();
+
+  // Tracking statistics: how often the point was predicted visible / actually matched.
+  void increase_visible(int n = 1);
+  void increase_found(int n = 1);
+  [[nodiscard]] float found_ratio() const;
+  [[nodiscard]] int visible_count() const;
+  [[nodiscard]] int found_count() const;
+
+  // Lifetime. set_bad() erases the point from every keyframe that observes it (the map removes it
+  // separately, see Map::erase_map_point). replace() moves all observations to `other`.
+  [[nodiscard]] bool is_bad() const;
+  void set_bad();
+  void replace(const std::shared_ptr<MapPoint>& other);
+  [[nodiscard]] std::shared_ptr<MapPoint> replaced_by() const;
+
+ private:
+  mutable std::mutex position_mutex_;  // world_, normal_, min/max distance
+  geometry::Vec3 world_;
+  geometry::Vec3 normal_ = geometry::Vec3::Zero();
+  float min_distance_ = 0;
+  float max_distance_ = 0;
+
+  mutable std::mutex features_mutex_;  // everything below
+  std::map<uint64_t, Observation> observations_;
+  int num_observations_ = 0;
+  std::weak_ptr<KeyFrame> reference_keyframe_;
+  Descriptor descriptor_{};
+  int visible_ = 1;
+  int found_ = 1;
+  bool bad_ = false;
+  std::weak_ptr<MapPoint> replaced_by_;
+};
+
+}  // namespace crowdslam::map

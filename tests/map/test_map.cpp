@@ -1,0 +1,261 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "crowdslam/map/keyframe.h"
+#include "crowdslam/map/map.h"
+#include "crowdslam/map/map_point.h"
+
+using namespace crowdslam;
+using namespace crowdslam::map;
+
+namespace {
+
+std::shared_ptr<geometry::PinholeCamera> test_camera() {
+  auto cam = std::make_shared<geometry::PinholeCamera>();
+  cam->fx = cam->fy = 500;
+  cam->cx = 320;
+  cam->cy = 240;
+  cam->width = 640;
+  cam->height = 480;
+  cam->bf = 40;
+  return cam;
+}
+
+// Features with n keypoints on a grid, random descriptors, optional depth on even indices.
+std::shared_ptr<FrameFeatures> make_features(size_t n, unsigned seed) {
+  auto f = std::make_shared<FrameFeatures>();
+  std::mt19937 rng(seed);
+  f->descriptors = cv::Mat(static_cast<int>(n), 32, CV_8UC1);
+  for (size_t i = 0; i < n; ++i) {
+    cv::KeyPoint kp(cv::Point2f(10.0f + 7.0f * (i % 80), 10.0f + 7.0f * (i / 80)), 31.0f, 0, 1, static_cast<int>(i % 3));
+    f->keys.push_back(kp);
+    f->keys_un.push_back(kp);
+    f->depth_m.push_back(i % 2 == 0 ? 2.0f : -1.0f);
+    f->right_u.push_back(i % 2 == 0 ? kp.pt.x - 20.0f : -1.0f);
+    for (int b = 0; b < 32; ++b) f->descriptors.at<uint8_t>(static_cast<int>(i), b) = static_cast<uint8_t>(rng());
+  }
+  f->grid = FeatureGrid(f->keys_un, geometry::ImageBounds{0, 640, 0, 480});
+  return f;
+}
+
+struct TestMap {
+  Map map;
+  std::shared_ptr<geometry::PinholeCamera> camera = test_camera();
+  std::shared_ptr<ScaleLevels> levels = std::make_shared<ScaleLevels>(1.2f, 8);
+
+  std::shared_ptr<KeyFrame> add_keyframe(size_t n_features = 200) {
+    const uint64_t id = map.next_keyframe_id();
+    geometry::Vec6 twist = geometry::Vec6::Zero();
+    twist(0) = 0.1 * static_cast<double>(id);
+    auto kf = std::make_shared<KeyFrame>(id, id * 3, 1.0 + id, camera, levels,
+                                         make_features(n_features, static_cast<unsigned>(id + 1)),
+                                         geometry::SE3::exp(twist));
+    map.add_keyframe(kf);
+    return kf;
+  }
+  // A point seen by the given keyframes at keypoint `index` in each.
+  std::shared_ptr<MapPoint> add_point(const std::vector<std::shared_ptr<KeyFrame>>& kfs, size_t index) {
+    auto p = std::make_shared<MapPoint>(map.next_map_point_id(), geometry::Vec3(0, 0, 2), kfs.front(), 0);
+    for (const auto& kf : kfs) {
+      kf->add_map_point(index, p);
+      p->add_observation(kf, index);
+    }
+    map.add_map_point(p);
+    return p;
+  }
+};
+
+}  // namespace
+
+TEST(FeatureGrid, AreaQueryMatchesBruteForce) {
+  const auto f = make_features(1000, 7);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> ux(0, 640), uy(0, 480), ur(1, 60);
+  for (int trial = 0; trial < 200; ++trial) {
+    const float x = ux(rng), y = uy(rng), r = ur(rng);
+    auto got = f->grid.features_in_area(f->keys_un, x, y, r, 1, 2);
+    std::sort(got.begin(), got.end());
+    std::vector<size_t> expected;
+    for (size_t i = 0; i < f->size(); ++i) {
+      const auto& kp = f->keys_un[i];
+      if (kp.octave >= 1 && kp.octave <= 2 && std::abs(kp.pt.x - x) < r && std::abs(kp.pt.y - y) < r)
+        expected.push_back(i);
+    }
+    ASSERT_EQ(got, expected) << "query " << x << "," << y << " r=" << r;
+  }
+}
+
+TEST(ScaleLevels, GeometricSeries) {
+  const ScaleLevels levels(1.2f, 8);
+  EXPECT_FLOAT_EQ(levels.scale[0], 1.0f);
+  EXPECT_NEAR(levels.scale[7], std::pow(1.2, 7), 1e-4);
+  EXPECT_NEAR(levels.inv_sigma2[3], 1.0 / std::pow(1.2, 6), 1e-6);
+}
+
+TEST(Covisibility, WeightsCountSharedPointsAndThresholdApplies) {
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe(), c = t.add_keyframe();
+  for (size_t i = 0; i < 20; ++i) t.add_point({a, b}, i);      // a-b share 20
+  for (size_t i = 20; i < 25; ++i) t.add_point({a, c}, i);     // a-c share 5 (< 15)
+  for (size_t i = 30; i < 60; ++i) t.add_point({b, c}, i);     // b-c share 30
+  a->update_connections();
+  EXPECT_EQ(a->weight(b->id), 20);
+  EXPECT_EQ(a->weight(c->id), 0);  // below threshold, and a strong edge exists
+  EXPECT_EQ(b->weight(a->id), 20);
+  c->update_connections();
+  ASSERT_EQ(c->best_covisible(1).size(), 1u);
+  EXPECT_EQ(c->best_covisible(1)[0]->id, b->id);
+  EXPECT_EQ(c->weight(b->id), 30);
+  EXPECT_EQ(c->covisible_by_weight(25).size(), 1u);
+}
+
+TEST(Covisibility, WeakOnlyNeighbourStillConnected) {
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe();
+  for (size_t i = 0; i < 4; ++i) t.add_point({a, b}, i);
+  b->update_connections();
+  EXPECT_EQ(b->weight(a->id), 4);
+  EXPECT_EQ(b->parent()->id, a->id);
+}
+
+TEST(MapPoint, StereoObservationsCountTwiceAndPointDiesWithFewObservations) {
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe(), c = t.add_keyframe();
+  auto p = t.add_point({a, b, c}, 1);  // index 1: monocular observations
+  EXPECT_EQ(p->num_observations(), 3);
+  auto q = t.add_point({a, b}, 2);  // index 2: has depth -> counts twice
+  EXPECT_EQ(q->num_observations(), 4);
+  p->erase_observation(a->id);  // 2 left -> bad
+  EXPECT_TRUE(p->is_bad());
+  EXPECT_EQ(b->map_point(1), nullptr);
+  EXPECT_EQ(t.map.erase_bad_map_points(), 1u);
+  EXPECT_EQ(t.map.num_map_points(), 1u);
+}
+
+TEST(MapPoint, DistinctiveDescriptorIsTheMedoid) {
+  TestMap t;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (int i = 0; i < 4; ++i) kfs.push_back(t.add_keyframe());
+  // Descriptors at index 5: a = 0, b = byte0 set (8 bits), c = bytes 0,1 (16), d = byte0 + one bit of byte2.
+  // Pairwise: ab 8, ac 16, ad 9, bc 8, bd 1, cd 9. Median (with self, index (n-1)/2) per row:
+  // a 8, b 1, c 8, d 1 -> b (first of the tie) is the distinctive descriptor.
+  std::vector<std::shared_ptr<FrameFeatures>> f;
+  for (auto& kf : kfs) {
+    f.push_back(std::const_pointer_cast<FrameFeatures>(kf->features));
+    f.back()->descriptors.row(5).setTo(0);
+  }
+  f[1]->descriptors.at<uint8_t>(5, 0) = 0xFF;
+  f[2]->descriptors.at<uint8_t>(5, 0) = 0xFF;
+  f[2]->descriptors.at<uint8_t>(5, 1) = 0xFF;
+  f[3]->descriptors.at<uint8_t>(5, 0) = 0xFF;
+  f[3]->descriptors.at<uint8_t>(5, 2) = 0x01;
+  auto p = t.add_point(kfs, 5);
+  p->compute_distinctive_descriptor();
+  const Descriptor d = p->descriptor();
+  EXPECT_EQ(d[0], 0xFF);
+  EXPECT_EQ(d[1], 0x00);
+  EXPECT_EQ(d[2], 0x00);
+}
+
+TEST(MapPoint, NormalAndScaleRange) {
+  TestMap t;
+  auto a = t.add_keyframe();  // camera centre at origin-ish, translation 0
+  auto b = t.add_keyframe();
+  auto p = t.add_point({a, b}, 3);  // octave 0 in a (3 % 3 == 0)
+  p->set_world(a->camera_center() + geometry::Vec3(0, 0, 4));
+  p->update_normal_and_depth();
+  EXPECT_NEAR(p->normal().norm(), 1.0, 1e-9);
+  // Level-0 observation at 4 m: max distance 4 * 1.2 (margin), min = 4 / 1.2^7 * 0.8.
+  EXPECT_NEAR(p->max_distance(), 4.0 * 1.2, 1e-4);
+  EXPECT_NEAR(p->min_distance(), 0.8 * 4.0 / std::pow(1.2, 7), 1e-4);
+  EXPECT_EQ(p->predict_scale(4.0f, *t.levels), 0);
+  EXPECT_EQ(p->predict_scale(4.0f / 1.2f / 1.2f, *t.levels), 2);
+}
+
+TEST(MapPoint, ReplaceMovesObservations) {
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe(), c = t.add_keyframe();
+  auto p = t.add_point({a, b}, 7);
+  auto q = t.add_point({c}, 9);
+  p->replace(q);
+  EXPECT_TRUE(p->is_bad());
+  EXPECT_EQ(p->replaced_by(), q);
+  EXPECT_EQ(a->map_point(7), q);
+  EXPECT_EQ(b->map_point(7), q);
+  EXPECT_TRUE(q->is_observed_by(a->id));
+  EXPECT_EQ(q->index_in(b->id), 7);
+}
+
+TEST(KeyFrame, CullingRepairsSpanningTreeAndUnlinks) {
+  TestMap t;
+  // Built incrementally, as tracking would: k1 attaches to k0; k2 shares most with k1; k3 with k1.
+  size_t idx = 0;
+  auto k0 = t.add_keyframe(), k1 = t.add_keyframe();
+  for (int i = 0; i < 20; ++i) t.add_point({k0, k1}, idx++);
+  k1->update_connections();
+  auto k2 = t.add_keyframe();
+  for (int i = 0; i < 30; ++i) t.add_point({k1, k2}, idx++);
+  for (int i = 0; i < 18; ++i) t.add_point({k0, k2}, idx++);
+  k2->update_connections();
+  auto k3 = t.add_keyframe();
+  for (int i = 0; i < 25; ++i) t.add_point({k1, k3}, idx++);
+  for (int i = 0; i < 18; ++i) t.add_point({k2, k3}, idx++);
+  k3->update_connections();
+  ASSERT_EQ(k1->parent(), k0);
+  ASSERT_EQ(k2->parent(), k1);
+  ASSERT_EQ(k3->parent(), k1);
+
+  k1->set_bad(t.map);
+  EXPECT_TRUE(k1->is_bad());
+  EXPECT_EQ(t.map.num_keyframes(), 3u);
+  EXPECT_EQ(k0->weight(k1->id), 0);
+  EXPECT_NE(k2->parent(), k1);
+  EXPECT_NE(k3->parent(), k1);
+  // Every remaining keyframe reaches the root through the tree.
+  for (auto kf : {k2, k3}) {
+    int steps = 0;
+    auto node = kf;
+    while (node->parent() && steps < 10) {
+      node = node->parent();
+      ++steps;
+    }
+    EXPECT_EQ(node, k0);
+  }
+  // The points only k1 and one other keyframe saw are gone with it (2 observations -> 1 -> bad).
+  EXPECT_GT(t.map.erase_bad_map_points(), 0u);
+  // Relative pose kept for trajectory output.
+  const auto rel = k1->cam_from_parent_at_erase();
+  EXPECT_LT((rel.matrix() - (k1->cam_from_world() * k0->world_from_cam()).matrix()).norm(), 1e-12);
+}
+
+TEST(KeyFrame, FirstKeyframeIsNeverErasedAndProtectionDefersErase) {
+  TestMap t;
+  auto k0 = t.add_keyframe(), k1 = t.add_keyframe();
+  k0->set_bad(t.map);
+  EXPECT_FALSE(k0->is_bad());
+  k1->set_not_erase();
+  k1->set_bad(t.map);
+  EXPECT_FALSE(k1->is_bad());
+  k1->set_erase(t.map);
+  EXPECT_TRUE(k1->is_bad());
+}
+
+TEST(Map, ClearFreesEverything) {
+  std::weak_ptr<KeyFrame> weak_kf;
+  std::weak_ptr<MapPoint> weak_point;
+  {
+    TestMap t;
+    auto a = t.add_keyframe(), b = t.add_keyframe();
+    for (size_t i = 0; i < 20; ++i) t.add_point({a, b}, i);
+    b->update_connections();
+    weak_kf = b;
+    weak_point = t.map.map_points().front();
+    a.reset();
+    b.reset();
+    t.map.clear();
+    EXPECT_EQ(t.map.num_keyframes(), 0u);
+  }
+  EXPECT_TRUE(weak_kf.expired());
+  EXPECT_TRUE(weak_point.expired());
+}
