@@ -26,6 +26,12 @@ Trajectory read_kitti_trajectory(const std::string& path, const std::vector<doub
 Trajectory read_euroc_trajectory(const std::string& path);
 // Picks the reader by content (EuRoC: ns stamps and commas; KITTI: 12 fields; TUM: 8 fields).
 Trajectory read_trajectory(const std::string& path);
+// The format read_trajectory() would pick: EuRoC when a '#' header names "[ns]" or the first data line
+// has commas, at least 8 fields and a stamp >= 1e11 (nanoseconds); else KITTI for 12 fields; else TUM
+// (also for empty files).
+TrajectoryFormat detect_trajectory_format(const std::string& path);
+// "tum", "kitti", "euroc".
+const char* to_string(TrajectoryFormat format);
 
 // Writers are atomic (util/atomic_file.h). TUM: timestamp with 6 decimals, pose values with 9.
 void write_tum_trajectory(const std::string& path, const Trajectory& trajectory);

@@ -1,0 +1,16 @@
+#include "crowdslam/eval/unique_stamps.h"
+
+#include "crowdslam/io/associate.h"
+
+namespace crowdslam::eval {
+
+io::Trajectory unique_sorted_by_stamp(const io::Trajectory& trajectory) {
+  std::vector<double> stamps;
+  stamps.reserve(trajectory.size());
+  for (const io::StampedPose& pose : trajectory) stamps.push_back(pose.timestamp_s);
+  io::Trajectory result;
+  for (std::size_t index : io::dedupe_last_wins(stamps)) result.push_back(trajectory[index]);
+  return result;
+}
+
+}  // namespace crowdslam::eval
