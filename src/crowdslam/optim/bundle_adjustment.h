@@ -1,0 +1,84 @@
+#pragma once
+// Local bundle adjustment (local mapping) with Ceres on plain data: keyframe poses
+// (cam_from_world, Se3Manifold) and 3D points. Independent of the map module: the mapper copies
+// its local window into these structs and writes the result back.
+//
+// Schedule (ORB-SLAM2 style):
+//   pass 1: all observations, Huber loss (delta^2 = chi2 threshold), first_pass_iterations;
+//   classify: chi2 > chi2_mono / chi2_stereo, or point not in front of the camera -> outlier;
+//   pass 2: inliers only, no robust loss, second_pass_iterations (skipped if aborted);
+//   final classification of every observation -> `outliers` (the mapper erases those).
+// Abort: when *abort_flag becomes true the running pass stops after its current iteration,
+// keeping the last accepted state (ceres::SOLVER_TERMINATE_SUCCESSFULLY), and pass 2 is skipped.
+// If the flag is already set on entry nothing is optimised and the input is returned unchanged.
+#include <atomic>
+#include <cstddef>
+#include <vector>
+
+#include "crowdslam/geometry/camera.h"
+#include "crowdslam/geometry/se3.h"
+
+namespace crowdslam::optim {
+
+struct BaKeyframe {
+  int id = -1;
+  geometry::SE3 cam_from_world;
+  bool fixed = false;  // covisible keyframes outside the local window (and the gauge keyframe)
+};
+
+struct BaPoint {
+  int id = -1;
+  geometry::Vec3 world = geometry::Vec3::Zero();
+};
+
+struct BaObservation {
+  int keyframe_id = -1;
+  int point_id = -1;
+  geometry::Vec2 pixel = geometry::Vec2::Zero();  // undistorted keypoint
+  double right_u = -1.0;                          // < 0: mono observation
+  double inv_sigma2 = 1.0;                        // 1 / sigma^2 of the keypoint's pyramid level
+
+  [[nodiscard]] bool is_stereo() const { return right_u >= 0.0; }
+};
+
+enum class BaLinearSolver {
+  kAuto,         // SPARSE_SCHUR when Ceres has a sparse backend, else DENSE_SCHUR
+  kSparseSchur,  // falls back to DENSE_SCHUR when no sparse backend is compiled in
+  kDenseSchur,
+};
+
+struct BundleAdjustmentOptions {
+  int first_pass_iterations = 5;
+  int second_pass_iterations = 10;  // 0 disables the second pass
+  double chi2_mono = 5.991;
+  double chi2_stereo = 7.815;
+  int num_threads = 1;
+  BaLinearSolver linear_solver = BaLinearSolver::kAuto;
+
+  // Throws InputError naming the bad option. Not called by local_bundle_adjustment: validate once.
+  void check() const;
+};
+
+struct BundleAdjustmentResult {
+  std::vector<BaKeyframe> keyframes;  // input order; fixed ones unchanged
+  std::vector<BaPoint> points;        // input order
+  std::vector<std::size_t> outliers;  // indices into the input observations, ascending
+  bool aborted = false;
+  int iterations = 0;  // Ceres iterations over both passes
+  double initial_cost = 0.0;
+  double final_cost = 0.0;  // of the last pass run (robust cost if pass 2 did not run)
+};
+
+// Observations must reference ids present in `keyframes` / `points` (unknown ids are skipped).
+// Stereo observations need camera.bf > 0; with bf = 0 they are used as mono.
+BundleAdjustmentResult local_bundle_adjustment(const geometry::PinholeCamera& camera,
+                                               const std::vector<BaKeyframe>& keyframes,
+                                               const std::vector<BaPoint>& points,
+                                               const std::vector<BaObservation>& observations,
+                                               const BundleAdjustmentOptions& options = {},
+                                               const std::atomic<bool>* abort_flag = nullptr);
+
+// Whether this Ceres build has a sparse linear algebra backend (SuiteSparse, CXSparse, Eigen...).
+bool ceres_has_sparse_backend();
+
+}  // namespace crowdslam::optim
