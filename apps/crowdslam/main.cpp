@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   add_dataset_command(app, global);
   add_eval_command(app, global);
   add_synth_command(app, global);
+  add_run_command(app, global);
 
   try {
     app.parse(argc, argv);

@@ -146,6 +146,11 @@ void MapPoint::compute_distinctive_descriptor() {
   std::copy(descriptors[best], descriptors[best] + 32, descriptor_.begin());
 }
 
+void MapPoint::set_descriptor(const uint8_t* descriptor) {
+  std::lock_guard lock(features_mutex_);
+  std::copy(descriptor, descriptor + 32, descriptor_.begin());
+}
+
 void MapPoint::update_normal_and_depth() {
   std::map<uint64_t, Observation> obs;
   std::shared_ptr<KeyFrame> reference;

@@ -52,6 +52,7 @@ class MapPoint {
   // Descriptor: the observation descriptor with the least median distance to the others.
   [[nodiscard]] Descriptor descriptor() const;
   void compute_distinctive_descriptor();
+  void set_descriptor(const uint8_t* descriptor);  // for points without observations (visual odometry)
   // Mean normal and scale-invariance distances from the current observations.
   void update_normal_and_depth();
 

@@ -1,0 +1,193 @@
+#include "crowdslam/mapping/local_mapper.h"
+
+#include <spdlog/spdlog.h>
+
+#include "crowdslam/map/map_point.h"
+#include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/util/error.h"
+#include <unordered_set>
+
+namespace crowdslam::mapping {
+
+void LocalMapperOptions::check() const {
+  if (!(close_depth_m > 0)) throw InputError("local mapper: close depth must be > 0");
+  if (triangulation_neighbours < 1) throw InputError("local mapper: triangulation_neighbours must be >= 1");
+  if (!(redundancy_ratio > 0 && redundancy_ratio <= 1)) throw InputError("local mapper: redundancy_ratio in (0, 1]");
+  ba.check();
+}
+
+LocalMapper::LocalMapper(const LocalMapperOptions& options, std::shared_ptr<map::Map> map)
+    : options_(options), map_(std::move(map)) {
+  options_.check();
+}
+
+LocalMapper::~LocalMapper() { stop(); }
+
+void LocalMapper::start() {
+  if (worker_.joinable()) return;
+  {
+    std::lock_guard lock(queue_mutex_);
+    stop_requested_ = false;
+  }
+  worker_ = std::thread([this] { run(); });
+}
+
+void LocalMapper::stop() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    stop_requested_ = true;
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LocalMapper::run() {
+  while (true) {
+    std::shared_ptr<map::KeyFrame> keyframe;
+    {
+      std::unique_lock lock(queue_mutex_);
+      accepting_ = true;
+      queue_cv_.wait(lock, [this] { return stop_requested_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stop requested and nothing left to do
+      accepting_ = false;
+      keyframe = queue_.front();
+      queue_.pop_front();
+    }
+    process_keyframe(keyframe);
+  }
+}
+
+void LocalMapper::process_all() {
+  while (auto keyframe = next_keyframe()) process_keyframe(keyframe);
+}
+
+std::shared_ptr<map::KeyFrame> LocalMapper::next_keyframe() {
+  std::lock_guard lock(queue_mutex_);
+  if (queue_.empty()) return nullptr;
+  auto keyframe = queue_.front();
+  queue_.pop_front();
+  return keyframe;
+}
+
+void LocalMapper::insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    queue_.push_back(std::move(keyframe));
+    abort_ba_ = true;
+  }
+  queue_cv_.notify_one();
+}
+
+bool LocalMapper::accepts_keyframes() const { return accepting_ && queued_keyframes() == 0; }
+
+size_t LocalMapper::queued_keyframes() const {
+  std::lock_guard lock(queue_mutex_);
+  return queue_.size();
+}
+
+bool LocalMapper::has_new_keyframes() const { return queued_keyframes() > 0; }
+
+void LocalMapper::interrupt_bundle_adjustment() { abort_ba_ = true; }
+
+void LocalMapper::reset() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    queue_.clear();
+  }
+  recent_points_.clear();
+}
+
+LocalMapperStats LocalMapper::stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe) {
+  register_keyframe(keyframe);
+  cull_recent_points(keyframe);
+  create_new_points(keyframe);
+  if (!has_new_keyframes()) fuse_with_neighbours(keyframe);
+  abort_ba_ = false;
+  if (!has_new_keyframes()) {
+    if (options_.local_ba && map_->num_keyframes() > 2) run_local_bundle_adjustment(keyframe);
+    cull_keyframes(keyframe);
+  }
+  map_->erase_bad_map_points();
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.keyframes_processed;
+}
+
+void LocalMapper::register_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe) {
+  const auto points = keyframe->map_points();
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto& point = points[i];
+    if (!point || point->is_bad()) continue;
+    if (!point->is_observed_by(keyframe->id)) {
+      point->add_observation(keyframe, i);
+      point->update_normal_and_depth();
+      point->compute_distinctive_descriptor();
+    } else {
+      // Created by tracking for this keyframe (from depth): check it in the next keyframes.
+      recent_points_.push_back(point);
+    }
+  }
+  keyframe->update_connections();
+  map_->add_keyframe(keyframe);
+}
+
+void LocalMapper::cull_recent_points(const std::shared_ptr<map::KeyFrame>& keyframe) {
+  const int observation_threshold = options_.monocular ? 2 : 3;
+  int culled = 0;
+  std::vector<std::shared_ptr<map::MapPoint>> kept;
+  kept.reserve(recent_points_.size());
+  for (auto& point : recent_points_) {
+    if (point->is_bad()) continue;
+    const uint64_t age = keyframe->id - point->first_keyframe_id;
+    if (point->found_ratio() < 0.25f) {
+      point->set_bad();
+      ++culled;
+    } else if (age >= 2 && point->num_observations() <= observation_threshold) {
+      point->set_bad();
+      ++culled;
+    } else if (age < 3) {
+      kept.push_back(std::move(point));
+    }
+  }
+  recent_points_.swap(kept);
+  std::lock_guard lock(stats_mutex_);
+  stats_.points_culled += culled;
+}
+
+void LocalMapper::fuse_with_neighbours(const std::shared_ptr<map::KeyFrame>& keyframe) {
+  const size_t first_ring = options_.monocular ? 20 : 10;
+  std::vector<std::shared_ptr<map::KeyFrame>> targets;
+  std::unordered_set<uint64_t> included{keyframe->id};
+  for (const auto& neighbour : keyframe->best_covisible(first_ring)) {
+    if (neighbour->is_bad() || !included.insert(neighbour->id).second) continue;
+    targets.push_back(neighbour);
+    for (const auto& second : neighbour->best_covisible(5)) {
+      if (second->is_bad() || !included.insert(second->id).second) continue;
+      targets.push_back(second);
+    }
+  }
+  // Current keyframe's points into the neighbours...
+  const auto own_points = keyframe->valid_map_points();
+  for (const auto& target : targets) match::fuse(target, own_points);
+  // ...and the neighbours' points into the current keyframe.
+  std::vector<std::shared_ptr<map::MapPoint>> candidates;
+  std::unordered_set<uint64_t> seen;
+  for (const auto& target : targets) {
+    for (auto& point : target->valid_map_points()) {
+      if (seen.insert(point->id).second) candidates.push_back(std::move(point));
+    }
+  }
+  match::fuse(keyframe, candidates);
+
+  for (const auto& point : keyframe->valid_map_points()) {
+    point->compute_distinctive_descriptor();
+    point->update_normal_and_depth();
+  }
+  keyframe->update_connections();
+}
+
+}  // namespace crowdslam::mapping

@@ -1,0 +1,99 @@
+#pragma once
+// Local mapping (ORB-SLAM2's LocalMapping, our way): takes keyframes from tracking and, per keyframe,
+// registers its observations, culls recent map points, triangulates new points with its neighbours, fuses
+// duplicates, runs local bundle adjustment and culls redundant keyframes.
+//
+// Threaded mode: start() runs a worker that sleeps on a condition variable until a keyframe arrives or
+// stop() is called. Sequential mode: don't start(); the owner calls process_all() after each tracked
+// frame, which makes runs reproducible.
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "crowdslam/map/keyframe.h"
+#include "crowdslam/map/map.h"
+#include "crowdslam/optim/bundle_adjustment.h"
+#include "crowdslam/tracking/keyframe_consumer.h"
+
+namespace crowdslam::mapping {
+
+struct LocalMapperOptions {
+  bool monocular = false;
+  double close_depth_m = 3.0;  // ThDepth in metres: only close points vote in keyframe culling
+  int triangulation_neighbours = 10;  // 20 for monocular
+  double redundancy_ratio = 0.9;      // keyframe culling: fraction of points seen by 3+ other keyframes
+  bool local_ba = true;
+  optim::BundleAdjustmentOptions ba;
+  void check() const;
+};
+
+struct LocalMapperStats {
+  int keyframes_processed = 0;
+  int points_created = 0;
+  int points_culled = 0;
+  int keyframes_culled = 0;
+  int ba_runs = 0;
+  int ba_aborted = 0;
+  double ba_time_ms_total = 0;
+};
+
+class LocalMapper : public tracking::KeyframeConsumer {
+ public:
+  LocalMapper(const LocalMapperOptions& options, std::shared_ptr<map::Map> map);
+  ~LocalMapper() override;
+  LocalMapper(const LocalMapper&) = delete;
+  LocalMapper& operator=(const LocalMapper&) = delete;
+
+  // Threaded mode.
+  void start();
+  // Finishes the queued keyframes, then stops the worker (idempotent).
+  void stop();
+
+  // Sequential mode: processes every queued keyframe on the caller's thread.
+  void process_all();
+
+  // KeyframeConsumer.
+  void insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe) override;
+  [[nodiscard]] bool accepts_keyframes() const override;
+  [[nodiscard]] size_t queued_keyframes() const override;
+  void interrupt_bundle_adjustment() override;
+  [[nodiscard]] bool is_paused() const override { return false; }
+
+  // Drops queued keyframes and recent points (after a map reset). Call with the worker idle or stopped.
+  void reset();
+  [[nodiscard]] LocalMapperStats stats() const;
+
+ private:
+  void run();
+  std::shared_ptr<map::KeyFrame> next_keyframe();
+  void process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe);
+  void register_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe);
+  void cull_recent_points(const std::shared_ptr<map::KeyFrame>& keyframe);
+  void create_new_points(const std::shared_ptr<map::KeyFrame>& keyframe);
+  void fuse_with_neighbours(const std::shared_ptr<map::KeyFrame>& keyframe);
+  void run_local_bundle_adjustment(const std::shared_ptr<map::KeyFrame>& keyframe);
+  void cull_keyframes(const std::shared_ptr<map::KeyFrame>& keyframe);
+  [[nodiscard]] bool has_new_keyframes() const;
+
+  LocalMapperOptions options_;
+  std::shared_ptr<map::Map> map_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<std::shared_ptr<map::KeyFrame>> queue_;
+  bool stop_requested_ = false;
+  std::atomic<bool> accepting_{true};
+  std::atomic<bool> abort_ba_{false};
+  std::thread worker_;
+
+  // Owned by the mapping thread (or the caller in sequential mode).
+  std::vector<std::shared_ptr<map::MapPoint>> recent_points_;
+  mutable std::mutex stats_mutex_;
+  LocalMapperStats stats_;
+};
+
+}  // namespace crowdslam::mapping

@@ -1,0 +1,436 @@
+#include "crowdslam/tracking/tracker.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "crowdslam/map/map_point.h"
+#include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::tracking {
+
+const char* to_string(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized:
+      return "not_initialized";
+    case TrackingState::kOk:
+      return "ok";
+    case TrackingState::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
+void TrackerOptions::check() const {
+  if (!(close_depth_m > 0)) throw InputError("tracker: close depth (ThDepth) must be > 0");
+  if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
+  if (max_frames_between_keyframes < 1) throw InputError("tracker: max frames between keyframes must be >= 1");
+  pose.check();
+}
+
+Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, KeyframeConsumer* mapper)
+    : options_(options), map_(std::move(map)), mapper_(mapper) {
+  options_.check();
+}
+
+void Tracker::reset() {
+  state_ = TrackingState::kNotInitialized;
+  last_frame_.reset();
+  velocity_.reset();
+  last_cam_from_reference_.reset();
+  reference_keyframe_.reset();
+  last_keyframe_.reset();
+  temporal_points_.clear();
+  local_keyframes_.clear();
+  local_points_.clear();
+}
+
+TrackResult Tracker::track(map::Frame frame) {
+  TrackResult result;
+  result.keypoints = static_cast<int>(frame.size());
+  std::unique_lock map_lock(map_->update_mutex());
+
+  if (state_ == TrackingState::kNotInitialized) {
+    if (initialize(frame)) {
+      state_ = TrackingState::kOk;
+      result.method = "init";
+      result.new_keyframe = true;
+    }
+  } else {
+    bool ok = false;
+    if (last_frame_) replace_replaced_points(*last_frame_);
+    if (state_ == TrackingState::kOk && velocity_ && last_frame_) {
+      ok = track_with_motion_model(frame);
+      result.method = "motion";
+    }
+    if (!ok) {
+      // Also the recovery path while lost (until place recognition exists): search the reference
+      // keyframe's points around the same pixels, starting from the last known pose.
+      ok = track_reference_keyframe(frame);
+      result.method = "reference";
+    }
+    frame.reference_keyframe = reference_keyframe_;
+    if (ok) ok = track_local_map(frame);
+    state_ = ok ? TrackingState::kOk : TrackingState::kLost;
+    if (!ok) result.method = "lost";
+
+    if (ok) {
+      if (last_frame_ && last_frame_->cam_from_world) {
+        velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
+      } else {
+        velocity_.reset();
+      }
+      // Visual-odometry matches (points created only for the last frame) are not map points.
+      for (auto& p : frame.map_points) {
+        if (p && p->num_observations() < 1) p.reset();
+      }
+      temporal_points_.clear();
+      if (need_new_keyframe(frame)) {
+        create_new_keyframe(frame);
+        result.new_keyframe = true;
+      }
+      // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
+      frame.discard_outliers();
+    } else {
+      velocity_.reset();
+      if (map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
+        spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
+        result.map_reset = true;
+      }
+    }
+  }
+  if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
+  if (frame.cam_from_world && frame.reference_keyframe && state_ == TrackingState::kOk) {
+    last_cam_from_reference_ = *frame.cam_from_world * frame.reference_keyframe->world_from_cam();
+  }
+  result.state = state_;
+  result.cam_from_world = state_ == TrackingState::kOk ? frame.cam_from_world : std::nullopt;
+  result.reference_keyframe = frame.reference_keyframe;
+  result.tracked_points = state_ == TrackingState::kOk ? inliers_in_local_map_ : 0;
+  last_frame_ = std::move(frame);
+  return result;
+}
+
+// ---- initialisation (RGB-D / stereo: one frame with depth) ----
+bool Tracker::initialize(map::Frame& frame) {
+  const auto& f = *frame.features;
+  int with_depth = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0) ++with_depth;
+  }
+  if (with_depth < options_.min_init_features) return false;
+
+  frame.cam_from_world = geometry::SE3::identity();
+  auto keyframe = std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
+                                                  frame.levels, frame.features, *frame.cam_from_world);
+  map_->add_keyframe(keyframe);
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] <= 0) continue;
+    auto point = make_point_from_depth(frame, i, keyframe);
+    frame.map_points[i] = point;
+  }
+  spdlog::info("map initialised with {} points at frame {}", map_->num_map_points(), frame.id);
+  mapper_->insert_keyframe(keyframe);
+  last_keyframe_ = keyframe;
+  last_keyframe_frame_id_ = frame.id;
+  reference_keyframe_ = keyframe;
+  frame.reference_keyframe = keyframe;
+  local_keyframes_ = {keyframe};
+  local_points_ = keyframe->valid_map_points();
+  inliers_in_local_map_ = static_cast<int>(local_points_.size());
+  return true;
+}
+
+std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& frame, size_t index,
+                                                              const std::shared_ptr<map::KeyFrame>& keyframe) const {
+  const auto& f = *frame.features;
+  const geometry::Vec2 pixel(f.keys_un[index].pt.x, f.keys_un[index].pt.y);
+  const geometry::Vec3 world = frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[index]);
+  auto point = std::make_shared<map::MapPoint>(map_->next_map_point_id(), world, keyframe, frame.id);
+  point->add_observation(keyframe, index);
+  keyframe->add_map_point(index, point);
+  point->compute_distinctive_descriptor();
+  point->update_normal_and_depth();
+  map_->add_map_point(point);
+  return point;
+}
+
+// ---- frame-to-frame tracking ----
+void Tracker::replace_replaced_points(map::Frame& frame) const {
+  for (auto& p : frame.map_points) {
+    if (!p) continue;
+    if (auto replacement = p->replaced_by()) p = replacement;
+  }
+}
+
+void Tracker::update_last_frame() {
+  map::Frame& last = *last_frame_;
+  // The reference keyframe may have moved since (local BA): re-anchor the last pose to it.
+  if (last.reference_keyframe && last_cam_from_reference_) {
+    last.cam_from_world = *last_cam_from_reference_ * last.reference_keyframe->cam_from_world();
+  }
+  // RGB-D: create visual-odometry points from the last frame's close depth points that have no map point,
+  // so the motion model has enough matches even in new areas.
+  const auto& f = *last.features;
+  std::vector<std::pair<float, size_t>> by_depth;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0) by_depth.emplace_back(f.depth_m[i], i);
+  }
+  if (by_depth.empty()) return;
+  std::sort(by_depth.begin(), by_depth.end());
+  int created = 0;
+  for (const auto& [depth, i] : by_depth) {
+    auto& slot = last.map_points[i];
+    if (!slot || slot->num_observations() < 1) {
+      const geometry::Vec2 pixel(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
+      const geometry::Vec3 world = last.cam_from_world->inverse() * last.camera->unproject(pixel, depth);
+      auto point = std::make_shared<map::MapPoint>(0, world, nullptr, last.id);
+      point->set_descriptor(f.descriptor(i));
+      slot = point;
+      temporal_points_.push_back(point);
+    }
+    ++created;
+    if (depth > options_.close_depth_m && created > 100) break;
+  }
+}
+
+int Tracker::optimize_pose(map::Frame& frame) const {
+  const auto& f = *frame.features;
+  std::vector<optim::PoseObservation> observations;
+  std::vector<size_t> slots;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p) continue;
+    optim::PoseObservation o;
+    o.point_world = p->world();
+    o.pixel = geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
+    o.right_u = f.right_u[i];
+    o.inv_sigma2 = frame.levels->inv_sigma2[f.keys_un[i].octave];
+    observations.push_back(o);
+    slots.push_back(i);
+  }
+  const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, observations, options_.pose);
+  if (!result.success) return 0;
+  frame.cam_from_world = result.cam_from_world;
+  for (size_t k = 0; k < slots.size(); ++k) frame.outliers[slots[k]] = !result.inliers[k];
+  return result.num_inliers;
+}
+
+bool Tracker::track_with_motion_model(map::Frame& frame) {
+  update_last_frame();
+  frame.cam_from_world = *velocity_ * *last_frame_->cam_from_world;
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  int matches = match::search_from_last_frame(frame, *last_frame_, options_.motion_model_radius);
+  if (matches < 20) {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    matches = match::search_from_last_frame(frame, *last_frame_, 2 * options_.motion_model_radius);
+  }
+  if (matches < 20) return false;
+  optimize_pose(frame);
+  int in_map = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!p) continue;
+    if (frame.outliers[i]) {
+      p.reset();
+      frame.outliers[i] = false;
+    } else if (p->num_observations() > 0) {
+      ++in_map;
+    }
+  }
+  return in_map >= 10;
+}
+
+bool Tracker::track_reference_keyframe(map::Frame& frame) {
+  if (!reference_keyframe_ || !last_frame_ || !last_frame_->cam_from_world) return false;
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  const int matches = match::search_keyframe_window(frame, *reference_keyframe_, options_.keyframe_window_radius);
+  if (matches < 15) return false;
+  frame.cam_from_world = *last_frame_->cam_from_world;
+  optimize_pose(frame);
+  int in_map = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!p) continue;
+    if (frame.outliers[i]) {
+      p.reset();
+      frame.outliers[i] = false;
+    } else if (p->num_observations() > 0) {
+      ++in_map;
+    }
+  }
+  return in_map >= 10;
+}
+
+// ---- local map ----
+void Tracker::update_local_map(const map::Frame& frame) {
+  // Keyframes that see the frame's points, weighted by how many.
+  std::unordered_map<uint64_t, std::pair<std::shared_ptr<map::KeyFrame>, int>> counter;
+  for (const auto& p : frame.map_points) {
+    if (!p || p->is_bad()) continue;
+    for (const auto& [kf_id, obs] : p->observations()) {
+      auto kf = obs.keyframe.lock();
+      if (!kf) continue;
+      auto& entry = counter[kf_id];
+      entry.first = std::move(kf);
+      ++entry.second;
+    }
+  }
+  if (counter.empty()) return;
+  local_keyframes_.clear();
+  std::unordered_set<uint64_t> included;
+  std::shared_ptr<map::KeyFrame> best;
+  int best_count = 0;
+  for (const auto& [id, entry] : counter) {
+    if (entry.first->is_bad()) continue;
+    if (entry.second > best_count) {
+      best_count = entry.second;
+      best = entry.first;
+    }
+    local_keyframes_.push_back(entry.first);
+    included.insert(id);
+  }
+  // Neighbours of those: best covisibles, children and parent (one of each per keyframe).
+  const size_t first_ring = local_keyframes_.size();
+  auto try_add = [&](const std::shared_ptr<map::KeyFrame>& kf) {
+    if (!kf || kf->is_bad() || included.count(kf->id)) return false;
+    included.insert(kf->id);
+    local_keyframes_.push_back(kf);
+    return true;
+  };
+  for (size_t k = 0; k < first_ring; ++k) {
+    if (local_keyframes_.size() > static_cast<size_t>(options_.max_local_keyframes)) break;
+    const auto kf = local_keyframes_[k];
+    for (const auto& neighbour : kf->best_covisible(10)) {
+      if (try_add(neighbour)) break;
+    }
+    for (const auto& child : kf->children()) {
+      if (try_add(child)) break;
+    }
+    try_add(kf->parent());
+  }
+  if (best) reference_keyframe_ = best;
+
+  local_points_.clear();
+  std::unordered_set<uint64_t> seen;
+  for (const auto& kf : local_keyframes_) {
+    for (auto& p : kf->valid_map_points()) {
+      if (seen.insert(p->id).second) local_points_.push_back(std::move(p));
+    }
+  }
+}
+
+bool Tracker::track_local_map(map::Frame& frame) {
+  update_local_map(frame);
+  frame.reference_keyframe = reference_keyframe_;
+
+  std::unordered_set<const map::MapPoint*> already;
+  for (const auto& p : frame.map_points) {
+    if (!p || p->is_bad()) continue;
+    already.insert(p.get());
+    p->increase_visible();
+  }
+  std::vector<match::ProjectedPoint> projected;
+  projected.reserve(local_points_.size());
+  for (const auto& p : local_points_) {
+    if (already.count(p.get())) continue;
+    if (auto projection = frame.project(*p, 0.5)) {
+      p->increase_visible();
+      projected.push_back({p, *projection});
+    }
+  }
+  if (!projected.empty()) match::search_local_points(frame, projected, options_.local_map_radius_factor);
+
+  optimize_pose(frame);
+  int inliers = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || frame.outliers[i]) continue;
+    p->increase_found();
+    if (p->num_observations() > 0) ++inliers;
+  }
+  inliers_in_local_map_ = inliers;
+  const bool recently_relocalized =
+      frame.id < last_relocalization_frame_id_ + static_cast<uint64_t>(options_.max_frames_between_keyframes) &&
+      last_relocalization_frame_id_ > 0;
+  if (recently_relocalized && inliers < 50) return false;
+  return inliers >= 30;
+}
+
+// ---- keyframes ----
+bool Tracker::need_new_keyframe(const map::Frame& frame) const {
+  if (mapper_->is_paused()) return false;
+  const size_t num_keyframes = map_->num_keyframes();
+  const auto max_frames = static_cast<uint64_t>(options_.max_frames_between_keyframes);
+  if (last_relocalization_frame_id_ > 0 && frame.id < last_relocalization_frame_id_ + max_frames &&
+      num_keyframes > max_frames) {
+    return false;
+  }
+  const int min_observations = num_keyframes <= 2 ? 2 : 3;
+  const int reference_matches = reference_keyframe_ ? reference_keyframe_->tracked_map_points(min_observations) : 0;
+  const bool mapper_idle = mapper_->accepts_keyframes();
+
+  // Close points (reliable depth) tracked vs. not tracked.
+  int tracked_close = 0;
+  int untracked_close = 0;
+  const auto& f = *frame.features;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0 && f.depth_m[i] < options_.close_depth_m) {
+      if (frame.map_points[i] && !frame.outliers[i]) {
+        ++tracked_close;
+      } else {
+        ++untracked_close;
+      }
+    }
+  }
+  const bool need_close = tracked_close < 100 && untracked_close > 70;
+  const double ref_ratio = num_keyframes < 2 ? 0.4 : 0.75;
+  const bool c1a = frame.id >= last_keyframe_frame_id_ + max_frames;
+  const bool c1b = frame.id >= last_keyframe_frame_id_ + static_cast<uint64_t>(options_.min_frames_between_keyframes) &&
+                   mapper_idle;
+  const bool c1c = inliers_in_local_map_ < reference_matches * 0.25 || need_close;
+  const bool c2 = (inliers_in_local_map_ < reference_matches * ref_ratio || need_close) && inliers_in_local_map_ > 15;
+  if (!((c1a || c1b || c1c) && c2)) return false;
+  if (mapper_idle) return true;
+  mapper_->interrupt_bundle_adjustment();
+  return mapper_->queued_keyframes() < 3;
+}
+
+void Tracker::create_new_keyframe(map::Frame& frame) {
+  auto keyframe = std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
+                                                  frame.levels, frame.features, *frame.cam_from_world);
+  // The keyframe takes the frame's current matches (the mapper adds the observations).
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    if (frame.map_points[i] && !frame.outliers[i]) keyframe->add_map_point(i, frame.map_points[i]);
+  }
+  // New points from the closest depth measurements without a map point.
+  const auto& f = *frame.features;
+  std::vector<std::pair<float, size_t>> by_depth;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0) by_depth.emplace_back(f.depth_m[i], i);
+  }
+  std::sort(by_depth.begin(), by_depth.end());
+  int count = 0;
+  for (const auto& [depth, i] : by_depth) {
+    const auto& existing = frame.map_points[i];
+    if (!existing || existing->num_observations() < 1 || frame.outliers[i]) {
+      frame.outliers[i] = false;
+      frame.map_points[i] = make_point_from_depth(frame, i, keyframe);
+    }
+    ++count;
+    if (depth > options_.close_depth_m && count > 100) break;
+  }
+  // make_point_from_depth already linked the new points; registered observations for the rest come
+  // from the mapper (process_new_keyframe).
+  reference_keyframe_ = keyframe;
+  frame.reference_keyframe = keyframe;
+  last_keyframe_ = keyframe;
+  last_keyframe_frame_id_ = frame.id;
+  mapper_->insert_keyframe(keyframe);
+}
+
+}  // namespace crowdslam::tracking

@@ -1,0 +1,89 @@
+#pragma once
+// The tracking state machine (ORB-SLAM2's Tracking::Track for RGB-D, written our way): initialisation,
+// motion-model and reference-keyframe tracking, local-map tracking, and keyframe creation.
+// Runs on the caller's thread; hands keyframes to a KeyframeConsumer (the local mapper).
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "crowdslam/map/frame.h"
+#include "crowdslam/map/keyframe.h"
+#include "crowdslam/map/map.h"
+#include "crowdslam/optim/pose_optimizer.h"
+#include "crowdslam/tracking/keyframe_consumer.h"
+
+namespace crowdslam::tracking {
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+const char* to_string(TrackingState state);
+
+struct TrackerOptions {
+  double close_depth_m = 3.0;         // "close" points (ThDepth * baseline): reliable depth
+  int min_init_features = 500;        // keypoints with depth needed to initialise (RGB-D)
+  int max_frames_between_keyframes = 30;  // usually the camera fps
+  int min_frames_between_keyframes = 0;
+  double motion_model_radius = 15.0;  // px at level 0 for the motion-model projection search
+  double keyframe_window_radius = 50.0;
+  double local_map_radius_factor = 3.0;  // RGB-D: larger windows when tracking the local map
+  int max_local_keyframes = 80;
+  int reset_if_lost_within_keyframes = 5;  // lost with so few keyframes: reset the map and start again
+  optim::PoseOptimizerOptions pose;
+  void check() const;
+};
+
+// Per-frame outcome, for statistics and trajectory output.
+struct TrackResult {
+  TrackingState state = TrackingState::kNotInitialized;
+  std::optional<geometry::SE3> cam_from_world;
+  std::shared_ptr<map::KeyFrame> reference_keyframe;
+  bool new_keyframe = false;
+  bool map_reset = false;
+  int tracked_points = 0;   // inliers after local-map tracking
+  int keypoints = 0;
+  const char* method = "";  // "init", "motion", "reference", "lost"
+};
+
+class Tracker {
+ public:
+  Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, KeyframeConsumer* mapper);
+
+  // Tracks one frame; `frame` is consumed (kept as the last frame).
+  TrackResult track(map::Frame frame);
+
+  [[nodiscard]] TrackingState state() const { return state_; }
+  [[nodiscard]] const map::Frame* last_frame() const { return last_frame_ ? &*last_frame_ : nullptr; }
+  void reset();
+
+ private:
+  bool initialize(map::Frame& frame);
+  bool track_with_motion_model(map::Frame& frame);
+  bool track_reference_keyframe(map::Frame& frame);
+  bool track_local_map(map::Frame& frame);
+  void update_last_frame();
+  void replace_replaced_points(map::Frame& frame) const;
+  void update_local_map(const map::Frame& frame);
+  int optimize_pose(map::Frame& frame) const;
+  bool need_new_keyframe(const map::Frame& frame) const;
+  void create_new_keyframe(map::Frame& frame);
+  std::shared_ptr<map::MapPoint> make_point_from_depth(const map::Frame& frame, size_t index,
+                                                       const std::shared_ptr<map::KeyFrame>& keyframe) const;
+
+  TrackerOptions options_;
+  std::shared_ptr<map::Map> map_;
+  KeyframeConsumer* mapper_;
+
+  TrackingState state_ = TrackingState::kNotInitialized;
+  std::optional<map::Frame> last_frame_;
+  std::optional<geometry::SE3> velocity_;
+  std::optional<geometry::SE3> last_cam_from_reference_;  // cam_from_world(current) * world_from_cam(last)
+  std::shared_ptr<map::KeyFrame> reference_keyframe_;
+  std::shared_ptr<map::KeyFrame> last_keyframe_;
+  uint64_t last_keyframe_frame_id_ = 0;
+  uint64_t last_relocalization_frame_id_ = 0;
+  int inliers_in_local_map_ = 0;
+  std::vector<std::shared_ptr<map::MapPoint>> temporal_points_;  // visual-odometry points of the last frame
+  std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
+  std::vector<std::shared_ptr<map::MapPoint>> local_points_;
+};
+
+}  // namespace crowdslam::tracking
