@@ -1,0 +1,64 @@
+#include "crowdslam/system/frame_prefetcher.h"
+
+namespace crowdslam::system {
+
+FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames)
+    : source_(source), capacity_(std::max<size_t>(1, capacity)), max_frames_(max_frames) {
+  reader_ = std::thread([this] { run(); });
+}
+
+FramePrefetcher::~FramePrefetcher() {
+  {
+    std::lock_guard lock(mutex_);
+    cancelled_ = true;
+  }
+  not_full_.notify_all();
+  if (reader_.joinable()) reader_.join();
+}
+
+void FramePrefetcher::run() {
+  size_t produced = 0;
+  while (max_frames_ == 0 || produced < max_frames_) {
+    {
+      std::unique_lock lock(mutex_);
+      not_full_.wait(lock, [this] { return cancelled_ || queue_.size() < capacity_; });
+      if (cancelled_) break;
+    }
+    std::optional<io::Frame> frame;
+    try {
+      frame = source_.next();
+    } catch (...) {
+      std::lock_guard lock(mutex_);
+      error_ = std::current_exception();
+      break;
+    }
+    if (!frame) break;
+    {
+      std::lock_guard lock(mutex_);
+      queue_.push_back(std::move(*frame));
+    }
+    ++produced;
+    not_empty_.notify_one();
+  }
+  {
+    std::lock_guard lock(mutex_);
+    finished_ = true;
+  }
+  not_empty_.notify_all();
+}
+
+std::optional<io::Frame> FramePrefetcher::next() {
+  std::unique_lock lock(mutex_);
+  not_empty_.wait(lock, [this] { return !queue_.empty() || finished_; });
+  if (!queue_.empty()) {
+    io::Frame frame = std::move(queue_.front());
+    queue_.pop_front();
+    lock.unlock();
+    not_full_.notify_one();
+    return frame;
+  }
+  if (error_) std::rethrow_exception(error_);
+  return std::nullopt;
+}
+
+}  // namespace crowdslam::system
