@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <random>
@@ -60,6 +61,7 @@ CliResult run_cli(const std::vector<std::string>& args) {
   TempDir tmp;
   const auto out_path = tmp / "stdout";
   const auto err_path = tmp / "stderr";
+  std::fflush(nullptr);
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {

@@ -1,0 +1,160 @@
+// load_settings, FeatureBudgetSettings::factor_for, operator==.
+#include "crowdslam/io/settings.h"
+
+#include "crowdslam/io/settings_reader.h"
+
+namespace crowdslam::io {
+namespace {
+
+template <typename T>
+void set_if(std::optional<T> value, T& target) {
+  if (value) target = *value;
+}
+
+CameraSettings read_camera(const SettingsReader& r, SensorKind sensor) {
+  CameraSettings c;
+  c.fx = r.required_real("Camera.fx");
+  c.fy = r.required_real("Camera.fy");
+  c.cx = r.required_real("Camera.cx");
+  c.cy = r.required_real("Camera.cy");
+  c.k1 = r.required_real("Camera.k1");
+  c.k2 = r.required_real("Camera.k2");
+  c.p1 = r.required_real("Camera.p1");
+  c.p2 = r.required_real("Camera.p2");
+  set_if(r.real("Camera.k3"), c.k3);
+  set_if(r.integer("Camera.width"), c.width);
+  set_if(r.integer("Camera.height"), c.height);
+  c.fps = r.required_real("Camera.fps");
+  set_if(r.flag("Camera.RGB"), c.rgb);
+  if (sensor != SensorKind::kMonocular) {
+    c.bf = r.required_real("Camera.bf");
+  } else {
+    set_if(r.real("Camera.bf"), c.bf);
+  }
+  return c;
+}
+
+OrbSettings read_orb(const SettingsReader& r) {
+  OrbSettings o;
+  o.n_features = r.required_integer("ORBextractor.nFeatures");
+  o.scale_factor = r.required_real("ORBextractor.scaleFactor");
+  o.n_levels = r.required_integer("ORBextractor.nLevels");
+  o.ini_th_fast = r.required_integer("ORBextractor.iniThFAST");
+  o.min_th_fast = r.required_integer("ORBextractor.minThFAST");
+  return o;
+}
+
+RectificationSide read_side(const SettingsReader& r, const std::string& side) {
+  RectificationSide s;
+  s.height = r.required_integer(side + ".height");
+  s.width = r.required_integer(side + ".width");
+  s.K = r.required_matrix(side + ".K");
+  s.D = r.required_matrix(side + ".D");
+  s.R = r.required_matrix(side + ".R");
+  s.P = r.required_matrix(side + ".P");
+  return s;
+}
+
+std::optional<StereoRectification> read_rectification(const SettingsReader& r) {
+  bool any = false;
+  for (const char* side : {"LEFT", "RIGHT"})
+    for (const char* key : {".height", ".width", ".K", ".D", ".R", ".P"})
+      any = any || r.has(std::string(side) + key);
+  if (!any) return std::nullopt;
+  return StereoRectification{read_side(r, "LEFT"), read_side(r, "RIGHT")};
+}
+
+void read_own_sections(const SettingsReader& r, Settings& s) {
+  set_if(r.text("Detector.model_cfg"), s.detector.model_cfg);
+  set_if(r.text("Detector.model_weights"), s.detector.model_weights);
+  set_if(r.integer("Detector.input_size"), s.detector.input_size);
+  set_if(r.real("Detector.confidence"), s.detector.confidence);
+  set_if(r.real("Detector.nms"), s.detector.nms);
+  set_if(r.integer("Detector.person_class"), s.detector.person_class);
+  set_if(r.flag("Detector.filter_before_nms"), s.detector.filter_before_nms);
+  set_if(r.flag("PeopleFilter.enabled"), s.people_filter.enabled);
+  set_if(r.text("PeopleFilter.mode"), s.people_filter.mode);
+  set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
+  set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
+  set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
+  set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);
+  set_if(r.text("Output.trajectory_format"), s.output.trajectory_format);
+}
+
+bool same_matrix(const cv::Mat& a, const cv::Mat& b) {
+  if (a.empty() || b.empty()) return a.empty() && b.empty();
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+bool same_side(const RectificationSide& a, const RectificationSide& b) {
+  return a.width == b.width && a.height == b.height && same_matrix(a.K, b.K) && same_matrix(a.D, b.D) &&
+         same_matrix(a.R, b.R) && same_matrix(a.P, b.P);
+}
+
+bool same_rectification(const std::optional<StereoRectification>& a,
+                        const std::optional<StereoRectification>& b) {
+  if (!a || !b) return !a && !b;
+  return same_side(a->left, b->left) && same_side(a->right, b->right);
+}
+
+}  // namespace
+
+double FeatureBudgetSettings::factor_for(double people_area_fraction) const {
+  if (thresholds.empty() || factors.empty()) return 1.0;
+  if (people_area_fraction <= thresholds.front()) return factors.front();
+  for (std::size_t i = 1; i < thresholds.size() && i < factors.size(); ++i)
+    if (people_area_fraction < thresholds[i]) return factors[i];
+  return factors.back();
+}
+
+Settings load_settings(const std::string& path, SensorKind sensor) {
+  const SettingsReader r(path);
+  Settings s;
+  s.path = path;
+  s.camera = read_camera(r, sensor);
+  if (sensor != SensorKind::kMonocular) {
+    s.th_depth = r.required_real("ThDepth");
+  } else {
+    set_if(r.real("ThDepth"), s.th_depth);
+  }
+  if (sensor == SensorKind::kRgbd) {
+    s.depth_map_factor = r.required_real("DepthMapFactor");
+  } else {
+    set_if(r.real("DepthMapFactor"), s.depth_map_factor);
+  }
+  s.orb = read_orb(r);
+  s.rectification = read_rectification(r);
+  read_own_sections(r, s);
+  s.check(sensor);
+  return s;
+}
+
+bool operator==(const Settings& a, const Settings& b) {
+  const auto& ca = a.camera;
+  const auto& cb = b.camera;
+  const bool camera = ca.fx == cb.fx && ca.fy == cb.fy && ca.cx == cb.cx && ca.cy == cb.cy &&
+                      ca.k1 == cb.k1 && ca.k2 == cb.k2 && ca.p1 == cb.p1 && ca.p2 == cb.p2 &&
+                      ca.k3 == cb.k3 && ca.width == cb.width && ca.height == cb.height && ca.bf == cb.bf &&
+                      ca.fps == cb.fps && ca.rgb == cb.rgb;
+  const bool orb = a.orb.n_features == b.orb.n_features && a.orb.scale_factor == b.orb.scale_factor &&
+                   a.orb.n_levels == b.orb.n_levels && a.orb.ini_th_fast == b.orb.ini_th_fast &&
+                   a.orb.min_th_fast == b.orb.min_th_fast;
+  const auto& da = a.detector;
+  const auto& db = b.detector;
+  const bool detector = da.model_cfg == db.model_cfg && da.model_weights == db.model_weights &&
+                        da.input_size == db.input_size && da.confidence == db.confidence &&
+                        da.nms == db.nms && da.person_class == db.person_class &&
+                        da.filter_before_nms == db.filter_before_nms;
+  const bool people = a.people_filter.enabled == b.people_filter.enabled &&
+                      a.people_filter.mode == b.people_filter.mode &&
+                      a.people_filter.margin_px == b.people_filter.margin_px;
+  const bool budget = a.feature_budget.enabled == b.feature_budget.enabled &&
+                      a.feature_budget.thresholds == b.feature_budget.thresholds &&
+                      a.feature_budget.factors == b.feature_budget.factors;
+  return camera && orb && detector && people && budget && a.th_depth == b.th_depth &&
+         a.depth_map_factor == b.depth_map_factor &&
+         a.output.trajectory_format == b.output.trajectory_format &&
+         same_rectification(a.rectification, b.rectification);
+}
+
+}  // namespace crowdslam::io

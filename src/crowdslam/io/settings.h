@@ -1,0 +1,111 @@
+#pragma once
+// ORB-SLAM2-style settings files (YAML read with cv::FileStorage, first line "%YAML:1.0"), plus our own
+// sections (Detector, PeopleFilter, FeatureBudget, Output) which take defaults when absent.
+//
+// ORB-SLAM2 keys. Required: Camera.fx/fy/cx/cy, Camera.k1/k2/p1/p2, Camera.fps, ORBextractor.nFeatures/
+// scaleFactor/nLevels/iniThFAST/minThFAST; for stereo and RGB-D also Camera.bf and ThDepth; for RGB-D also
+// DepthMapFactor. Optional: Camera.k3 (0), Camera.width/height (0 = unknown), Camera.RGB (1), and the
+// stereo rectification LEFT.height/width/K/D/R/P + RIGHT.* (all twelve or none; matrices as opencv-matrix).
+// As in ORB-SLAM2, Camera.* describe the images SLAM works on: for stereo files with rectification
+// those are the rectified images, so Camera.fx/fy/cx/cy must match LEFT.P and Camera.bf must match
+// -RIGHT.P(0,3) (checked, 0.1% tolerance).
+//
+// Every missing or invalid value throws InputError "FILE: KEY: reason".
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "crowdslam/io/dataset.h"
+
+namespace crowdslam::io {
+
+struct CameraSettings {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  double k1 = 0.0, k2 = 0.0, p1 = 0.0, p2 = 0.0, k3 = 0.0;
+  int width = 0;    // 0 = not given
+  int height = 0;   // 0 = not given
+  double bf = 0.0;  // baseline (m) * fx; stereo and RGB-D
+  double fps = 30.0;
+  bool rgb = true;  // Camera.RGB: 1 = colour images are RGB ordered, 0 = BGR (ORB-SLAM2 meaning)
+};
+
+struct OrbSettings {
+  int n_features = 1000;
+  double scale_factor = 1.2;
+  int n_levels = 8;
+  int ini_th_fast = 20;
+  int min_th_fast = 7;
+};
+
+struct RectificationSide {
+  int width = 0;
+  int height = 0;
+  cv::Mat K;  // 3x3 CV_64F
+  cv::Mat D;  // 1xN CV_64F (4, 5, 8, 12 or 14 coefficients)
+  cv::Mat R;  // 3x3 CV_64F
+  cv::Mat P;  // 3x4 CV_64F
+};
+
+struct StereoRectification {
+  RectificationSide left;
+  RectificationSide right;
+};
+
+struct DetectorSettings {
+  std::string model_cfg;      // Darknet .cfg (empty = not configured)
+  std::string model_weights;  // Darknet .weights
+  int input_size = 160;       // network input (square), multiple of 32
+  double confidence = 0.2;
+  double nms = 0.1;
+  int person_class = 0;
+  bool filter_before_nms = true;
+};
+
+struct PeopleFilterSettings {
+  bool enabled = true;
+  std::string mode = "paper";  // "paper" | "depth"
+  double margin_px = 5.0;
+};
+
+struct FeatureBudgetSettings {
+  bool enabled = true;
+  std::vector<double> thresholds{0.0, 0.3, 0.6, 0.9, 0.95};
+  std::vector<double> factors{1.0, 1.3, 1.5, 1.7, 1.9, 2.2};
+  // Factor for the fraction of the image covered by people: a <= thresholds[0] -> factors[0],
+  // a < thresholds[i] -> factors[i], else factors.back().
+  [[nodiscard]] double factor_for(double people_area_fraction) const;
+};
+
+struct OutputSettings {
+  std::string trajectory_format = "tum";  // "tum" | "kitti" | "euroc"
+};
+
+struct Settings {
+  std::string path;  // the file read (not part of operator==)
+  CameraSettings camera;
+  double th_depth = 40.0;         // close/far threshold in multiples of the baseline (stereo, RGB-D)
+  double depth_map_factor = 1.0;  // raw depth / factor = metres (RGB-D)
+  OrbSettings orb;
+  std::optional<StereoRectification> rectification;
+  DetectorSettings detector;
+  PeopleFilterSettings people_filter;
+  FeatureBudgetSettings feature_budget;
+  OutputSettings output;
+
+  // Validates every value for the sensor; throws InputError "PATH: KEY: reason".
+  void check(SensorKind sensor) const;
+};
+
+bool operator==(const Settings& a, const Settings& b);
+inline bool operator!=(const Settings& a, const Settings& b) { return !(a == b); }
+
+// Reads and checks a settings file. Keys required only for stereo / RGB-D (Camera.bf, ThDepth,
+// DepthMapFactor) are enforced for that sensor.
+Settings load_settings(const std::string& path, SensorKind sensor);
+
+// Writes every key (ORB-SLAM2 names, our sections, rectification when present) atomically; numbers with
+// 17 significant digits, so load_settings(path, sensor) == settings. Checks nothing.
+void write_settings(const std::string& path, const Settings& settings);
+
+}  // namespace crowdslam::io

@@ -1,0 +1,162 @@
+// Settings::check: every value validated, errors name the file and the key.
+#include <cmath>
+#include <sstream>
+
+#include "crowdslam/io/settings.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::io {
+namespace {
+
+constexpr double kConsistencyTolerance = 1e-3;  // relative, Camera.* vs LEFT.P / RIGHT.P
+
+class Checker {
+ public:
+  explicit Checker(const std::string& path) : path_(path.empty() ? std::string("settings") : path) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw input_error(path_, key + ": " + reason);
+  }
+  template <typename T>
+  void require(bool ok, const std::string& key, const std::string& rule, T value) const {
+    if (ok) return;
+    std::ostringstream os;
+    os.precision(17);
+    os << "must be " << rule << ", got " << value;
+    fail(key, os.str());
+  }
+  void finite(double value, const std::string& key) const {
+    require(std::isfinite(value), key, "finite", value);
+  }
+  void positive(double value, const std::string& key) const {
+    require(std::isfinite(value) && value > 0, key, "> 0", value);
+  }
+  void close(double value, double expected, const std::string& key, const std::string& other) const {
+    const double scale = std::max(std::abs(expected), 1.0);
+    if (std::abs(value - expected) <= kConsistencyTolerance * scale) return;
+    std::ostringstream os;
+    os.precision(17);
+    os << "is " << value << " but " << other << " gives " << expected
+       << " (Camera.* describe the rectified images)";
+    fail(key, os.str());
+  }
+
+ private:
+  std::string path_;
+};
+
+void check_camera(const Checker& c, const CameraSettings& cam, SensorKind sensor) {
+  c.positive(cam.fx, "Camera.fx");
+  c.positive(cam.fy, "Camera.fy");
+  for (const auto& [value, key] : {std::pair{cam.k1, "Camera.k1"},
+                                   {cam.k2, "Camera.k2"},
+                                   {cam.p1, "Camera.p1"},
+                                   {cam.p2, "Camera.p2"},
+                                   {cam.k3, "Camera.k3"}})
+    c.finite(value, key);
+  c.require(cam.width >= 0, "Camera.width", ">= 0", cam.width);
+  c.require(cam.height >= 0, "Camera.height", ">= 0", cam.height);
+  const std::string cx_rule =
+      cam.width > 0 ? "in (0, Camera.width=" + std::to_string(cam.width) + ")" : "> 0";
+  const std::string cy_rule =
+      cam.height > 0 ? "in (0, Camera.height=" + std::to_string(cam.height) + ")" : "> 0";
+  c.require(std::isfinite(cam.cx) && cam.cx > 0 && (cam.width == 0 || cam.cx < cam.width), "Camera.cx",
+            cx_rule, cam.cx);
+  c.require(std::isfinite(cam.cy) && cam.cy > 0 && (cam.height == 0 || cam.cy < cam.height), "Camera.cy",
+            cy_rule, cam.cy);
+  c.positive(cam.fps, "Camera.fps");
+  if (sensor != SensorKind::kMonocular) {
+    c.positive(cam.bf, "Camera.bf");
+  } else {
+    c.require(std::isfinite(cam.bf) && cam.bf >= 0, "Camera.bf", ">= 0", cam.bf);
+  }
+}
+
+void check_orb(const Checker& c, const OrbSettings& o) {
+  c.require(o.n_features > 0, "ORBextractor.nFeatures", "> 0", o.n_features);
+  c.require(std::isfinite(o.scale_factor) && o.scale_factor > 1.0, "ORBextractor.scaleFactor", "> 1",
+            o.scale_factor);
+  c.require(o.n_levels >= 1 && o.n_levels <= 20, "ORBextractor.nLevels", "in 1..20", o.n_levels);
+  c.require(o.min_th_fast > 0, "ORBextractor.minThFAST", "> 0", o.min_th_fast);
+  c.require(o.ini_th_fast >= o.min_th_fast, "ORBextractor.iniThFAST", ">= ORBextractor.minThFAST",
+            o.ini_th_fast);
+}
+
+void check_side(const Checker& c, const RectificationSide& s, const std::string& side) {
+  c.require(s.width > 0, side + ".width", "> 0", s.width);
+  c.require(s.height > 0, side + ".height", "> 0", s.height);
+  auto shape = [&](const cv::Mat& m, int rows, int cols, const std::string& key) {
+    if (m.rows != rows || m.cols != cols)
+      c.fail(key, "must be " + std::to_string(rows) + "x" + std::to_string(cols) + ", got " +
+                      std::to_string(m.rows) + "x" + std::to_string(m.cols));
+  };
+  shape(s.K, 3, 3, side + ".K");
+  shape(s.R, 3, 3, side + ".R");
+  shape(s.P, 3, 4, side + ".P");
+  const int n = static_cast<int>(s.D.total());
+  if ((s.D.rows != 1 && s.D.cols != 1) || (n != 4 && n != 5 && n != 8 && n != 12 && n != 14))
+    c.fail(side + ".D", "must be a 1xN vector with N in {4, 5, 8, 12, 14}");
+  c.require(s.K.at<double>(0, 0) > 0 && s.K.at<double>(1, 1) > 0, side + ".K", "with positive focal lengths",
+            s.K.at<double>(0, 0));
+  const cv::Mat should_be_identity = s.R.t() * s.R - cv::Mat::eye(3, 3, CV_64F);
+  if (cv::norm(should_be_identity, cv::NORM_INF) > 1e-4 || cv::determinant(s.R) <= 0)
+    c.fail(side + ".R", "must be a rotation matrix");
+  c.require(s.P.at<double>(0, 0) > 0 && s.P.at<double>(1, 1) > 0, side + ".P", "with positive focal lengths",
+            s.P.at<double>(0, 0));
+}
+
+void check_rectification(const Checker& c, const StereoRectification& r, const CameraSettings& cam) {
+  check_side(c, r.left, "LEFT");
+  check_side(c, r.right, "RIGHT");
+  const cv::Mat& p = r.left.P;
+  c.close(cam.fx, p.at<double>(0, 0), "Camera.fx", "LEFT.P(0,0)");
+  c.close(cam.fy, p.at<double>(1, 1), "Camera.fy", "LEFT.P(1,1)");
+  c.close(cam.cx, p.at<double>(0, 2), "Camera.cx", "LEFT.P(0,2)");
+  c.close(cam.cy, p.at<double>(1, 2), "Camera.cy", "LEFT.P(1,2)");
+  if (cam.bf > 0) c.close(cam.bf, -r.right.P.at<double>(0, 3), "Camera.bf", "-RIGHT.P(0,3)");
+}
+
+void check_own_sections(const Checker& c, const Settings& s) {
+  const auto& d = s.detector;
+  c.require(d.input_size > 0 && d.input_size % 32 == 0, "Detector.input_size", "a positive multiple of 32",
+            d.input_size);
+  c.require(std::isfinite(d.confidence) && d.confidence > 0 && d.confidence <= 1, "Detector.confidence",
+            "in (0, 1]", d.confidence);
+  c.require(std::isfinite(d.nms) && d.nms > 0 && d.nms <= 1, "Detector.nms", "in (0, 1]", d.nms);
+  c.require(d.person_class >= 0, "Detector.person_class", ">= 0", d.person_class);
+  const auto& p = s.people_filter;
+  c.require(p.mode == "paper" || p.mode == "depth", "PeopleFilter.mode", "\"paper\" or \"depth\"",
+            "\"" + p.mode + "\"");
+  c.require(std::isfinite(p.margin_px) && p.margin_px >= 0, "PeopleFilter.margin_px", ">= 0", p.margin_px);
+  const auto& b = s.feature_budget;
+  if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
+  for (std::size_t i = 0; i < b.thresholds.size(); ++i) {
+    c.require(b.thresholds[i] >= 0 && b.thresholds[i] <= 1, "FeatureBudget.thresholds", "fractions in [0, 1]",
+              b.thresholds[i]);
+    if (i > 0)
+      c.require(b.thresholds[i] > b.thresholds[i - 1], "FeatureBudget.thresholds", "strictly increasing",
+                b.thresholds[i]);
+  }
+  if (b.factors.size() != b.thresholds.size() + 1)
+    c.fail("FeatureBudget.factors", "must have one more entry than FeatureBudget.thresholds (" +
+                                        std::to_string(b.thresholds.size() + 1) + "), got " +
+                                        std::to_string(b.factors.size()));
+  for (const double f : b.factors) c.positive(f, "FeatureBudget.factors");
+  const auto& format = s.output.trajectory_format;
+  c.require(format == "tum" || format == "kitti" || format == "euroc", "Output.trajectory_format",
+            "\"tum\", \"kitti\" or \"euroc\"", "\"" + format + "\"");
+}
+
+}  // namespace
+
+void Settings::check(SensorKind sensor) const {
+  const Checker c(path);
+  check_camera(c, camera, sensor);
+  c.positive(th_depth, "ThDepth");  // required (checked at load) only for stereo / RGB-D; defaults are valid
+  c.positive(depth_map_factor, "DepthMapFactor");
+  check_orb(c, orb);
+  if (rectification) check_rectification(c, *rectification, camera);
+  check_own_sections(c, *this);
+}
+
+}  // namespace crowdslam::io

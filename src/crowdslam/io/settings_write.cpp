@@ -1,0 +1,118 @@
+// write_settings: YAML that cv::FileStorage (and ORB-SLAM2) reads back to the same values.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "crowdslam/io/settings.h"
+#include "crowdslam/util/atomic_file.h"
+
+namespace crowdslam::io {
+namespace {
+
+// Shortest of %.15g / %.17g that reads back exactly; always looks like a real (has '.', 'e' or "inf").
+std::string real_text(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.15g", value);
+  if (std::strtod(buffer, nullptr) != value) std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  std::string text(buffer);
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+std::string list_text(const std::vector<double>& values) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) out += (i ? ", " : " ") + real_text(values[i]);
+  return out + " ]";
+}
+
+void write_matrix(std::ostream& out, const std::string& key, const cv::Mat& matrix) {
+  cv::Mat m;
+  matrix.convertTo(m, CV_64F);
+  out << key << ": !!opencv-matrix\n   rows: " << m.rows << "\n   cols: " << m.cols
+      << "\n   dt: d\n   data: [";
+  for (int r = 0; r < m.rows; ++r)
+    for (int c = 0; c < m.cols; ++c) out << ((r || c) ? ", " : " ") << real_text(m.at<double>(r, c));
+  out << " ]\n";
+}
+
+void write_side(std::ostream& out, const std::string& side, const RectificationSide& s) {
+  out << side << ".height: " << s.height << "\n" << side << ".width: " << s.width << "\n";
+  write_matrix(out, side + ".D", s.D);
+  write_matrix(out, side + ".K", s.K);
+  write_matrix(out, side + ".R", s.R);
+  write_matrix(out, side + ".P", s.P);
+}
+
+void write_camera(std::ostream& out, const Settings& s) {
+  const auto& c = s.camera;
+  out << "# Camera (of the images SLAM works on: rectified for stereo with LEFT/RIGHT blocks)\n";
+  out << "Camera.fx: " << real_text(c.fx) << "\nCamera.fy: " << real_text(c.fy)
+      << "\nCamera.cx: " << real_text(c.cx) << "\nCamera.cy: " << real_text(c.cy) << "\n\n";
+  out << "Camera.k1: " << real_text(c.k1) << "\nCamera.k2: " << real_text(c.k2)
+      << "\nCamera.p1: " << real_text(c.p1) << "\nCamera.p2: " << real_text(c.p2)
+      << "\nCamera.k3: " << real_text(c.k3) << "\n\n";
+  if (c.width > 0) out << "Camera.width: " << c.width << "\n";
+  if (c.height > 0) out << "Camera.height: " << c.height << "\n";
+  out << "Camera.fps: " << real_text(c.fps) << "\nCamera.bf: " << real_text(c.bf) << "\n";
+  out << "# Colour order of the images (0: BGR, 1: RGB; ignored for grey images)\nCamera.RGB: "
+      << (c.rgb ? 1 : 0) << "\n\n";
+  out << "# Close/far threshold (baseline multiples)\nThDepth: " << real_text(s.th_depth) << "\n";
+  out << "# Depth map values factor (raw / factor = metres)\nDepthMapFactor: "
+      << real_text(s.depth_map_factor) << "\n\n";
+}
+
+void write_orb(std::ostream& out, const OrbSettings& o) {
+  out << "# ORB extractor\nORBextractor.nFeatures: " << o.n_features
+      << "\nORBextractor.scaleFactor: " << real_text(o.scale_factor)
+      << "\nORBextractor.nLevels: " << o.n_levels << "\nORBextractor.iniThFAST: " << o.ini_th_fast
+      << "\nORBextractor.minThFAST: " << o.min_th_fast << "\n\n";
+}
+
+void write_own_sections(std::ostream& out, const Settings& s) {
+  const auto& d = s.detector;
+  out << "# Person detector (Darknet model through OpenCV DNN)\n";
+  out << "Detector.model_cfg: " << quoted(d.model_cfg)
+      << "\nDetector.model_weights: " << quoted(d.model_weights) << "\nDetector.input_size: " << d.input_size
+      << "\nDetector.confidence: " << real_text(d.confidence) << "\nDetector.nms: " << real_text(d.nms)
+      << "\nDetector.person_class: " << d.person_class
+      << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0) << "\n\n";
+  const auto& p = s.people_filter;
+  out << "# Keypoints on people (mode \"paper\" or \"depth\")\nPeopleFilter.enabled: " << (p.enabled ? 1 : 0)
+      << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
+      << "\n\n";
+  const auto& b = s.feature_budget;
+  out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
+         "people\nFeatureBudget.enabled: "
+      << (b.enabled ? 1 : 0) << "\nFeatureBudget.thresholds: " << list_text(b.thresholds)
+      << "\nFeatureBudget.factors: " << list_text(b.factors) << "\n\n";
+  out << "# Output\nOutput.trajectory_format: " << quoted(s.output.trajectory_format) << "\n";
+}
+
+}  // namespace
+
+void write_settings(const std::string& path, const Settings& settings) {
+  std::ostringstream out;
+  out << "%YAML:1.0\n---\n# crowdslam settings (ORB-SLAM2 compatible keys plus our own sections)\n\n";
+  write_camera(out, settings);
+  write_orb(out, settings.orb);
+  if (settings.rectification) {
+    out << "# Stereo rectification\n";
+    write_side(out, "LEFT", settings.rectification->left);
+    write_side(out, "RIGHT", settings.rectification->right);
+    out << "\n";
+  }
+  write_own_sections(out, settings);
+  write_file_atomic(path, out.str());
+}
+
+}  // namespace crowdslam::io
