@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/util/error.h"
@@ -103,18 +105,36 @@ LocalMapperStats LocalMapper::stats() const {
 }
 
 void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  };
+  const auto start = Clock::now();
   register_keyframe(keyframe);
   cull_recent_points(keyframe);
+  const double register_ms = ms_since(start);
+  auto t = Clock::now();
   create_new_points(keyframe);
+  const double triangulation_ms = ms_since(t);
+  t = Clock::now();
   if (!has_new_keyframes()) fuse_with_neighbours(keyframe);
+  const double fusion_ms = ms_since(t);
   abort_ba_ = false;
+  double culling_ms = 0;
   if (!has_new_keyframes()) {
     if (options_.local_ba && map_->num_keyframes() > 2) run_local_bundle_adjustment(keyframe);
+    t = Clock::now();
     cull_keyframes(keyframe);
+    culling_ms = ms_since(t);
   }
   map_->erase_bad_map_points();
   std::lock_guard lock(stats_mutex_);
   ++stats_.keyframes_processed;
+  stats_.register_ms_total += register_ms;
+  stats_.triangulation_ms_total += triangulation_ms;
+  stats_.fusion_ms_total += fusion_ms;
+  stats_.culling_ms_total += culling_ms;
+  stats_.processing_ms_total += ms_since(start);
 }
 
 void LocalMapper::register_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe) {

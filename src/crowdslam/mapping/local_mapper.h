@@ -39,6 +39,12 @@ struct LocalMapperStats {
   int ba_runs = 0;
   int ba_aborted = 0;
   double ba_time_ms_total = 0;
+  // Time per step over all keyframes (ms).
+  double register_ms_total = 0;
+  double triangulation_ms_total = 0;
+  double fusion_ms_total = 0;
+  double culling_ms_total = 0;
+  double processing_ms_total = 0;
 };
 
 class LocalMapper : public tracking::KeyframeConsumer {

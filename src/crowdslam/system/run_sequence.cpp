@@ -165,7 +165,12 @@ RunSummary run_sequence(const RunOptions& options) {
                           {"keyframes_culled", mapper.keyframes_culled},
                           {"ba_runs", mapper.ba_runs},
                           {"ba_aborted", mapper.ba_aborted},
-                          {"ba_ms_mean", mapper.ba_runs > 0 ? mapper.ba_time_ms_total / mapper.ba_runs : 0.0}};
+                          {"ba_ms_mean", mapper.ba_runs > 0 ? mapper.ba_time_ms_total / mapper.ba_runs : 0.0},
+                          {"register_ms_mean", mapper.register_ms_total / std::max(1, mapper.keyframes_processed)},
+                          {"triangulation_ms_mean", mapper.triangulation_ms_total / std::max(1, mapper.keyframes_processed)},
+                          {"fusion_ms_mean", mapper.fusion_ms_total / std::max(1, mapper.keyframes_processed)},
+                          {"culling_ms_mean", mapper.culling_ms_total / std::max(1, mapper.keyframes_processed)},
+                          {"keyframe_ms_mean", mapper.processing_ms_total / std::max(1, mapper.keyframes_processed)}};
   doc["accuracy"] = accuracy;
   doc["frames"] = std::move(frames);
   summary.json = doc;
