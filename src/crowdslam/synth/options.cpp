@@ -1,0 +1,56 @@
+#include "crowdslam/synth/options.h"
+
+#include <cmath>
+
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::synth {
+
+TrajectoryKind parse_trajectory_kind(const std::string& name) {
+  if (name == "loop") return TrajectoryKind::kLoop;
+  if (name == "line") return TrajectoryKind::kLine;
+  if (name == "sweep") return TrajectoryKind::kSweep;
+  if (name == "handheld") return TrajectoryKind::kHandheld;
+  throw InputError("--trajectory: unknown trajectory '" + name + "' (expected loop, line, sweep or handheld)");
+}
+
+std::string to_string(TrajectoryKind kind) {
+  switch (kind) {
+    case TrajectoryKind::kLoop: return "loop";
+    case TrajectoryKind::kLine: return "line";
+    case TrajectoryKind::kSweep: return "sweep";
+    case TrajectoryKind::kHandheld: return "handheld";
+  }
+  return "loop";
+}
+
+void SynthOptions::check() const {
+  if (frames < 1 || frames > 1000000) {
+    throw InputError("--frames: must be between 1 and 1000000, got " + std::to_string(frames));
+  }
+  if (people < 0 || people > 50) {
+    throw InputError("--people: must be between 0 and 50, got " + std::to_string(people));
+  }
+  if (width < 16 || width > 8192) {
+    throw InputError("--width: must be between 16 and 8192, got " + std::to_string(width));
+  }
+  if (height < 16 || height > 8192) {
+    throw InputError("--height: must be between 16 and 8192, got " + std::to_string(height));
+  }
+  if (!std::isfinite(noise_depth_m) || noise_depth_m < 0.0 || noise_depth_m > 1.0) {
+    throw InputError("--noise-depth: must be between 0 and 1 m, got " + std::to_string(noise_depth_m));
+  }
+}
+
+Intrinsics intrinsics_for(int width, int height) {
+  Intrinsics k;
+  k.width = width;
+  k.height = height;
+  k.fx = 525.0 * width / 640.0;
+  k.fy = k.fx;
+  k.cx = (width - 1) / 2.0;
+  k.cy = (height - 1) / 2.0;
+  return k;
+}
+
+}  // namespace crowdslam::synth

@@ -1,0 +1,30 @@
+#pragma once
+// Ray-casting renderer: one ray per pixel centre against the room, the obstacles and the people; exact
+// z-depth, trilinear texture lookup, a constant Lambertian shade per face. Pure function of its inputs
+// (no noise), so the same frame renders to the same bytes every time.
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "crowdslam/synth/scene.h"
+
+namespace crowdslam::synth {
+
+struct RenderedFrame {
+  cv::Mat colour;        // CV_8UC3, BGR
+  cv::Mat depth_m;       // CV_32F z-depth in metres (0 = nothing hit)
+  cv::Mat person_label;  // CV_16U id of the person seen at the pixel (0 = static scene)
+};
+
+// Renders the static scene plus `people` seen by a camera at world_from_cam.
+RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, const std::vector<Box>& people);
+// Frame `frame` of the sequence from the left (RGB) or right stereo camera.
+RenderedFrame render_frame(const Scene& scene, int frame, bool right_camera = false);
+
+// Bounding rectangle of the projection of the part of `box` in front of the camera, in 0-based pixel
+// coordinates (pixel centres at integers), clipped to [0, width-1] x [0, height-1]; nullopt when no part
+// of it projects into the image. Rectangle = (x, y, width, height) with x + width = right edge.
+std::optional<cv::Rect2d> projected_bounds(const Box& box, const geometry::SE3& cam_from_world,
+                                           const Intrinsics& intrinsics);
+
+}  // namespace crowdslam::synth

@@ -1,0 +1,316 @@
+#include "crowdslam/synth/writer.h"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "crowdslam/io/trajectory.h"
+#include "crowdslam/util/atomic_file.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::synth {
+namespace fs = std::filesystem;
+namespace {
+
+std::string format(const char* fmt, double a) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, a);
+  return buffer;
+}
+
+std::string frame_name(int frame) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%06d.png", frame);
+  return buffer;
+}
+
+// Fast PNG settings: zlib level 1; RLE for colour (photographs barely compress better, encode 25% faster).
+void write_png(const fs::path& path, const cv::Mat& image) {
+  bool ok = false;
+  const int strategy = image.channels() == 3 ? cv::IMWRITE_PNG_STRATEGY_RLE : cv::IMWRITE_PNG_STRATEGY_DEFAULT;
+  try {
+    ok = cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY, strategy});
+  } catch (const cv::Exception& e) {
+    throw input_error(path.string(), std::string("cannot write image: ") + e.what());
+  }
+  if (!ok) throw input_error(path.string(), "cannot write image");
+}
+
+cv::Mat depth_png(const cv::Mat& depth_m, double noise_sigma_m, Rng rng) {
+  cv::Mat out(depth_m.size(), CV_16U);
+  for (int y = 0; y < depth_m.rows; ++y) {
+    const float* in = depth_m.ptr<float>(y);
+    auto* o = out.ptr<std::uint16_t>(y);
+    for (int x = 0; x < depth_m.cols; ++x) {
+      double d = in[x];
+      if (d > 0.0 && noise_sigma_m > 0.0) d += noise_sigma_m * rng.normal();
+      o[x] = (d > 0.0 && d <= kMaxDepthM) ? static_cast<std::uint16_t>(std::lround(d * kDepthFactor)) : 0;
+    }
+  }
+  return out;
+}
+
+// What one frame contributes to the text files and the summary.
+struct FrameResult {
+  std::vector<PersonBox> boxes;
+  double coverage = 0.0;
+};
+
+void prepare_output(const SynthOptions& options, const fs::path& out_dir) {
+  std::error_code ec;
+  if (fs::exists(out_dir, ec)) {
+    if (!fs::is_directory(out_dir, ec)) throw input_error(out_dir.string(), "exists and is not a directory");
+    if (!fs::is_empty(out_dir, ec) && !options.force) {
+      throw input_error(out_dir.string(), "output directory exists and is not empty (use --force to replace it)");
+    }
+  }
+}
+
+class SequenceWriter {
+ public:
+  SequenceWriter(const Scene& scene, fs::path dir) : scene_(scene), dir_(std::move(dir)) {}
+
+  std::vector<FrameResult> write_frames() {
+    const SynthOptions& o = scene_.options();
+    const bool stereo = o.stereo;
+    fs::create_directories(dir_ / (stereo ? "image_0" : "rgb"));
+    fs::create_directories(dir_ / (stereo ? "image_1" : "depth"));
+    results_.assign(scene_.frame_count(), {});
+    const int threads = std::max(1, std::min(8, static_cast<int>(std::thread::hardware_concurrency())));
+    std::vector<std::thread> pool;
+    for (int i = 0; i < threads; ++i) pool.emplace_back([this] { work(); });
+    for (auto& t : pool) t.join();
+    if (error_) std::rethrow_exception(error_);
+    return std::move(results_);
+  }
+
+ private:
+  void work() {
+    while (!failed_) {
+      const int frame = next_++;
+      if (frame >= scene_.frame_count()) return;
+      try {
+        write_frame(frame);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (!error_) error_ = std::current_exception();
+        failed_ = true;
+      }
+    }
+  }
+
+  void write_frame(int frame) {
+    const SynthOptions& o = scene_.options();
+    const std::string name = frame_name(frame);
+    const geometry::SE3& world_from_cam = scene_.trajectory()[frame].world_from_cam;
+    const std::vector<Box> people = scene_.people_boxes(frame);
+    const RenderedFrame left = render(scene_, world_from_cam, people);
+    if (o.stereo) {
+      write_png(dir_ / "image_0" / name, left.colour);
+      write_png(dir_ / "image_1" / name, render(scene_, scene_.right_world_from_cam(frame), people).colour);
+    } else {
+      write_png(dir_ / "rgb" / name, left.colour);
+      write_png(dir_ / "depth" / name, depth_png(left.depth_m, o.noise_depth_m, Rng(o.seed, 0xde97ULL + frame)));
+    }
+    FrameResult& result = results_[frame];
+    result.boxes = visible_person_boxes(scene_, left, world_from_cam, frame);
+    result.coverage = static_cast<double>(cv::countNonZero(left.person_label)) / left.person_label.total();
+    if (frame % 100 == 0) spdlog::debug("synth: frame {}/{}", frame, scene_.frame_count());
+  }
+
+  const Scene& scene_;
+  fs::path dir_;
+  std::vector<FrameResult> results_;
+  std::atomic<int> next_{0};
+  std::atomic<bool> failed_{false};
+  std::mutex mutex_;
+  std::exception_ptr error_;
+};
+
+std::string image_list(const Scene& scene, const std::string& folder, const std::string& what) {
+  std::ostringstream out;
+  out << "# " << what << "\n# file: 'crowdslam synth'\n# timestamp filename\n";
+  for (int i = 0; i < scene.frame_count(); ++i) {
+    out << format("%.6f", scene.trajectory()[i].timestamp_s) << ' ' << folder << '/' << frame_name(i) << '\n';
+  }
+  return out.str();
+}
+
+std::string calib_txt(const Intrinsics& k) {
+  const auto row = [&k](const std::string& name, double tx) {
+    std::ostringstream out;
+    out << name << ':';
+    const double values[12] = {k.fx, 0, k.cx, tx, 0, k.fy, k.cy, 0, 0, 0, 1, 0};
+    for (double v : values) out << ' ' << format("%.12e", v);
+    out << '\n';
+    return out.str();
+  };
+  const double right_tx = -k.fx * kStereoBaselineM;
+  return row("P0", 0.0) + row("P1", right_tx) + row("P2", 0.0) + row("P3", right_tx);
+}
+
+std::string people_gt(const std::vector<FrameResult>& results) {
+  std::ostringstream out;
+  char line[160];
+  for (size_t f = 0; f < results.size(); ++f) {
+    for (const PersonBox& p : results[f].boxes) {
+      std::snprintf(line, sizeof line, "%zu,%d,%.2f,%.2f,%.2f,%.2f,1,-1,-1,-1\n", f + 1, p.id, p.box.x, p.box.y,
+                    p.box.width, p.box.height);
+      out << line;
+    }
+  }
+  return out.str();
+}
+
+SequenceSummary summarise(const Scene& scene, const std::vector<FrameResult>& results) {
+  SequenceSummary s;
+  s.frames = scene.frame_count();
+  s.photo_textures = scene.photo_textures();
+  s.min_person_distance_m = std::numeric_limits<double>::infinity();
+  for (const FrameResult& r : results) {
+    s.person_boxes += static_cast<int>(r.boxes.size());
+    s.max_person_coverage = std::max(s.max_person_coverage, r.coverage);
+  }
+  for (const PersonTrack& track : scene.people()) {
+    for (int f = 0; f < scene.frame_count(); ++f) {
+      const Eigen::Vector2d centre = scene.trajectory()[f].world_from_cam.translation().head<2>();
+      s.min_person_distance_m = std::min(s.min_person_distance_m, distance_to_person(track.states[f], centre));
+    }
+  }
+  return s;
+}
+
+nlohmann::json synth_json(const Scene& scene, const SequenceSummary& summary) {
+  const SynthOptions& o = scene.options();
+  const Intrinsics& k = scene.intrinsics();
+  nlohmann::json j;
+  j["generator"] = kGeneratorVersion;
+  j["seed"] = o.seed;
+  j["frames"] = o.frames;
+  j["people"] = o.people;
+  j["stereo"] = o.stereo;
+  j["layout"] = o.stereo ? "kitti" : "tum";
+  j["trajectory"] = to_string(o.trajectory);
+  j["width"] = o.width;
+  j["height"] = o.height;
+  j["noise_depth_m"] = o.noise_depth_m;
+  j["fps"] = kFps;
+  j["first_timestamp_s"] = kFirstTimestampS;
+  j["depth_factor"] = kDepthFactor;
+  j["max_depth_m"] = kMaxDepthM;
+  j["baseline_m"] = o.stereo ? kStereoBaselineM : 0.0;
+  j["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}};
+  j["textures"] = scene.photo_textures() ? "photos" : "procedural";
+  j["person_boxes"] = summary.person_boxes;
+  j["max_person_coverage"] = summary.max_person_coverage;
+  if (std::isfinite(summary.min_person_distance_m)) j["min_person_distance_m"] = summary.min_person_distance_m;
+  return j;
+}
+
+void write_text_files(const Scene& scene, const fs::path& dir, const std::vector<FrameResult>& results,
+                      const SequenceSummary& summary) {
+  const SynthOptions& o = scene.options();
+  if (o.stereo) {
+    std::ostringstream times;
+    for (const auto& pose : scene.trajectory()) times << format("%.6e", pose.timestamp_s) << '\n';
+    write_file_atomic(dir / "times.txt", times.str());
+    write_file_atomic(dir / "calib.txt", calib_txt(scene.intrinsics()));
+    io::write_kitti_trajectory((dir / "poses.txt").string(), scene.trajectory());
+  } else {
+    write_file_atomic(dir / "rgb.txt", image_list(scene, "rgb", "color images"));
+    write_file_atomic(dir / "depth.txt", image_list(scene, "depth", "depth maps"));
+  }
+  io::write_tum_trajectory((dir / "groundtruth.txt").string(), scene.trajectory());
+  write_file_atomic(dir / "settings.yaml", settings_yaml(o));
+  write_file_atomic(dir / "people_gt.txt", people_gt(results));
+  write_file_atomic(dir / "synth.json", synth_json(scene, summary).dump(2) + "\n");
+}
+
+}  // namespace
+
+std::vector<PersonBox> visible_person_boxes(const Scene& scene, const RenderedFrame& rendered,
+                                            const geometry::SE3& world_from_cam, int frame) {
+  const int count = static_cast<int>(scene.people().size());
+  std::vector<bool> seen(count + 1, false);
+  for (int y = 0; y < rendered.person_label.rows; ++y) {
+    const auto* row = rendered.person_label.ptr<std::uint16_t>(y);
+    for (int x = 0; x < rendered.person_label.cols; ++x) {
+      if (row[x] > 0 && row[x] <= count) seen[row[x]] = true;
+    }
+  }
+  std::vector<PersonBox> boxes;
+  const geometry::SE3 cam_from_world = world_from_cam.inverse();
+  for (const Box& person : scene.people_boxes(frame)) {
+    if (!seen[person.person_id]) continue;
+    const auto bounds = projected_bounds(person, cam_from_world, scene.intrinsics());
+    if (bounds) boxes.push_back({person.person_id, *bounds});
+  }
+  return boxes;
+}
+
+std::string settings_yaml(const SynthOptions& o) {
+  const Intrinsics k = intrinsics_for(o.width, o.height);
+  std::ostringstream out;
+  out << "%YAML:1.0\n\n# crowdslam synth: " << (o.stereo ? "rectified stereo" : "RGB-D") << ", seed " << o.seed
+      << "\nCamera.fx: " << format("%.6f", k.fx) << "\nCamera.fy: " << format("%.6f", k.fy)
+      << "\nCamera.cx: " << format("%.6f", k.cx) << "\nCamera.cy: " << format("%.6f", k.cy)
+      << "\n\nCamera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n"
+      << "\nCamera.width: " << o.width << "\nCamera.height: " << o.height << "\nCamera.fps: 30.0\n"
+      << "\n# stereo baseline times fx (RGB-D: a virtual baseline for the close/far point threshold)\n"
+      << "Camera.bf: " << format("%.6f", o.stereo ? k.fx * kStereoBaselineM : 40.0)
+      << "\n\n# colour order of the images (0: BGR, 1: RGB; the PNG files are read as usual)\nCamera.RGB: 1\n"
+      << "\nThDepth: 40.0\n";
+  if (!o.stereo) out << "DepthMapFactor: " << format("%.1f", kDepthFactor) << "\n";
+  out << "\nORBextractor.nFeatures: 1000\nORBextractor.scaleFactor: 1.2\nORBextractor.nLevels: 8\n"
+      << "ORBextractor.iniThFAST: 20\nORBextractor.minThFAST: 7\n";
+  return out.str();
+}
+
+SequenceSummary write_sequence(const SynthOptions& options, const fs::path& out_dir_arg) {
+  const auto start = std::chrono::steady_clock::now();
+  options.check();
+  fs::path out_dir = out_dir_arg;
+  if (!out_dir.has_filename()) out_dir = out_dir.parent_path();  // "dir/" -> "dir"
+  if (out_dir.empty()) throw InputError("--out: empty output directory");
+  if (out_dir.filename() == "." || out_dir.filename() == "..") {
+    throw input_error(out_dir.string(), "name the output directory itself (not '.' or '..')");
+  }
+  prepare_output(options, out_dir);
+  fs::path tmp = out_dir;
+  tmp += ".tmp-" + std::to_string(::getpid());
+  remove_quietly(tmp);
+  try {
+    std::error_code ec;
+    fs::create_directories(tmp, ec);
+    if (ec) throw input_error(tmp.string(), "cannot create directory: " + ec.message());
+    const Scene scene = Scene::build(options);
+    if (!scene.photo_textures()) {
+      spdlog::warn("synth: no photographs in '{}' (install opencv-doc); using procedural textures",
+                   options.texture_dir);
+    }
+    const std::vector<FrameResult> results = SequenceWriter(scene, tmp).write_frames();
+    SequenceSummary summary = summarise(scene, results);
+    write_text_files(scene, tmp, results, summary);
+    if (fs::exists(out_dir, ec)) fs::remove_all(out_dir);
+    fs::rename(tmp, out_dir, ec);
+    if (ec) throw input_error(out_dir.string(), "cannot move the finished dataset into place: " + ec.message());
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  } catch (...) {
+    remove_quietly(tmp);
+    throw;
+  }
+}
+
+}  // namespace crowdslam::synth

@@ -1,0 +1,47 @@
+#pragma once
+// Writes a complete synthetic dataset.
+//
+// RGB-D (default), TUM layout: rgb/NNNNNN.png, depth/NNNNNN.png (16-bit, depth_m * 5000, 0 = missing),
+// rgb.txt, depth.txt, groundtruth.txt (TUM), settings.yaml (ORB-SLAM2 style), people_gt.txt, synth.json.
+// Stereo (--stereo), KITTI odometry layout: image_0/ and image_1/ (BGR PNG), times.txt, calib.txt,
+// poses.txt (KITTI), plus groundtruth.txt, settings.yaml, people_gt.txt, synth.json.
+//
+// people_gt.txt is MOT style, one line per person visible in a frame (at least one pixel):
+//   frame(1-based),id,x,y,w,h,1,-1,-1,-1
+// where (x, y, w, h) is the bounding rectangle of the projection of the person's 3D box in 0-based pixel
+// coordinates (pixel centres at integers, as OpenCV), clipped to the image.
+//
+// The output appears atomically: everything is written into "<out_dir>.tmp-<pid>" which is renamed to
+// out_dir at the end; an existing non-empty out_dir is an error unless options.force.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "crowdslam/synth/render.h"
+#include "crowdslam/synth/scene.h"
+
+namespace crowdslam::synth {
+
+struct SequenceSummary {
+  int frames = 0;
+  int person_boxes = 0;         // lines in people_gt.txt
+  double min_person_distance_m = 0.0;  // closest any person's body came to the camera centre (inf: none)
+  double max_person_coverage = 0.0;    // largest fraction of an image covered by people
+  double seconds = 0.0;
+  bool photo_textures = false;
+};
+
+SequenceSummary write_sequence(const SynthOptions& options, const std::filesystem::path& out_dir);
+
+// The MOT lines (without frame-independent parts) for one rendered frame: visible people and their boxes.
+struct PersonBox {
+  int id = 0;
+  cv::Rect2d box;
+};
+std::vector<PersonBox> visible_person_boxes(const Scene& scene, const RenderedFrame& rendered,
+                                            const geometry::SE3& world_from_cam, int frame);
+
+// settings.yaml content for the options (ORB-SLAM2 style).
+std::string settings_yaml(const SynthOptions& options);
+
+}  // namespace crowdslam::synth
