@@ -142,7 +142,9 @@ TEST(ORBExtractor, OctaveScaleAndPositionAreConsistent) {
     EXPECT_LT(k.angle, 360.f);
     EXPECT_GT(k.response, 0.f);
     const cv::Mat& level_image = extractor.pyramid()[k.octave];
-    const cv::Point2f level_pt = k.pt * extractor.inv_scale_factors()[k.octave];
+    // Level-0 coordinates map back with the pixel-centre convention: x = (x0 + 0.5) * w / w0 - 0.5.
+    const cv::Point2f level_pt((k.pt.x + 0.5f) * level_image.cols / gray.cols - 0.5f,
+                               (k.pt.y + 0.5f) * level_image.rows / gray.rows - 0.5f);
     EXPECT_NEAR(level_pt.x, std::round(level_pt.x), 1e-3) << "FAST positions are whole level pixels";
     EXPECT_GE(level_pt.x, kOrbEdgeThreshold - 1e-3);
     EXPECT_GE(level_pt.y, kOrbEdgeThreshold - 1e-3);

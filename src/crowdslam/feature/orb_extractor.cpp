@@ -197,10 +197,15 @@ void ORBExtractor::extract(const cv::Mat& gray, int num_features, std::vector<cv
     cv::Mat blurred = blurred_(cv::Rect(0, 0, image.cols, image.rows));
     // BORDER_ISOLATED keeps OpenCV on its bit-exact fixed-point path even when `gray` is a view.
     cv::GaussianBlur(image, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101 | cv::BORDER_ISOLATED);
-    const float scale = scale_factors_[level];
+    // Level -> level-0 pixel coordinates with pixel centres at integers. cv::resize (INTER_LINEAR)
+    // aligns pixel centres, so the exact map is x0 = (x + 0.5) * (w0 / w) - 0.5; ORB-SLAM's x0 = x * s
+    // puts level-l keypoints up to 0.5 (s_l - 1) px (1.3 px at level 7) up and to the left.
+    const float scale_x = static_cast<float>(gray.cols) / static_cast<float>(image.cols);
+    const float scale_y = static_cast<float>(gray.rows) / static_cast<float>(image.rows);
     for (cv::KeyPoint keypoint : level_keypoints) {
       steered_brief(blurred, keypoint.pt, keypoint.angle, descriptors.ptr<std::uint8_t>(row++));
-      keypoint.pt *= scale;
+      keypoint.pt.x = (keypoint.pt.x + 0.5f) * scale_x - 0.5f;
+      keypoint.pt.y = (keypoint.pt.y + 0.5f) * scale_y - 0.5f;
       keypoints.push_back(keypoint);
     }
   }
