@@ -388,7 +388,7 @@ bool Tracker::need_new_keyframe(const map::Frame& frame) const {
     }
   }
   const bool need_close = tracked_close < 100 && untracked_close > 70;
-  const double ref_ratio = num_keyframes < 2 ? 0.4 : 0.75;
+  const double ref_ratio = num_keyframes < 2 ? 0.4 : options_.keyframe_reference_ratio;
   const bool c1a = frame.id >= last_keyframe_frame_id_ + max_frames;
   const bool c1b = frame.id >= last_keyframe_frame_id_ + static_cast<uint64_t>(options_.min_frames_between_keyframes) &&
                    mapper_idle;

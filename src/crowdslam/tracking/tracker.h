@@ -26,6 +26,9 @@ struct TrackerOptions {
   double keyframe_window_radius = 50.0;
   double local_map_radius_factor = 3.0;  // RGB-D: larger windows when tracking the local map
   int max_local_keyframes = 80;
+  // A keyframe is due when the frame tracks fewer than this fraction of its reference keyframe's points
+  // (ORB-SLAM2 uses 0.75 for RGB-D; more keyframes measured better, see docs/RESULTS.md).
+  double keyframe_reference_ratio = 0.9;
   int reset_if_lost_within_keyframes = 5;  // lost with so few keyframes: reset the map and start again
   optim::PoseOptimizerOptions pose;
   void check() const;
