@@ -1,0 +1,80 @@
+#include "crowdslam/people/detection_worker.h"
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace crowdslam::people {
+
+DetectionWorker::DetectionWorker(std::unique_ptr<PersonDetector> detector)
+    : detector_(std::move(detector)), thread_([this] { run(); }) {}
+
+DetectionWorker::~DetectionWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_worker_.notify_all();
+  thread_.join();
+}
+
+void DetectionWorker::submit(std::size_t frame_index, cv::Mat bgr) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_ != State::kIdle)
+      throw std::logic_error("DetectionWorker::submit(" + std::to_string(frame_index) + "): frame " +
+                             std::to_string(frame_index_) + " is still in flight");
+    frame_index_ = frame_index;
+    image_ = std::move(bgr);
+    error_ = nullptr;
+    state_ = State::kPending;
+  }
+  wake_worker_.notify_one();
+}
+
+WorkerResult DetectionWorker::wait(std::size_t frame_index) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (state_ == State::kIdle || frame_index_ != frame_index)
+    throw std::logic_error("DetectionWorker::wait(" + std::to_string(frame_index) + "): frame not submitted");
+  result_ready_.wait(lock, [this] { return state_ == State::kDone; });
+  WorkerResult out;
+  out.frame_index = frame_index_;
+  out.waited_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  state_ = State::kIdle;
+  image_.release();
+  if (error_) {
+    std::exception_ptr error = std::exchange(error_, nullptr);
+    std::rethrow_exception(error);
+  }
+  out.detections = std::move(result_);
+  result_ = {};
+  return out;
+}
+
+void DetectionWorker::run() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    wake_worker_.wait(lock, [this] { return stop_ || state_ == State::kPending; });
+    if (stop_) return;
+    state_ = State::kRunning;
+    const cv::Mat image = image_;
+    const std::size_t frame_index = frame_index_;
+    lock.unlock();
+    Detections detections;
+    std::exception_ptr error;
+    try {
+      detections = detector_->detect(image, frame_index);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    lock.lock();
+    result_ = std::move(detections);
+    error_ = error;
+    state_ = State::kDone;
+    result_ready_.notify_all();
+  }
+}
+
+}  // namespace crowdslam::people

@@ -1,0 +1,69 @@
+#pragma once
+// Person detectors: the interface the SLAM system and the `crowdslam detect` tool use, and the options
+// shared by every backend.
+//
+// Backends: DarknetDetector (OpenCV DNN, Darknet .cfg/.weights or a YOLO .onnx export; darknet_detector.h)
+// and MotFileDetector (boxes read from a MOT-format file; mot_file_detector.h).
+//
+// Boxes are in pixels of the image given to detect(): x, y = top-left corner, clipped to the image.
+// `raw` keeps every box above the confidence threshold before non-maximum suppression (the original
+// Crowd-SLAM masked with those), `boxes` the ones NMS kept.
+#include <cstddef>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace crowdslam::people {
+
+struct PersonBox {
+  cv::Rect2f box;  // x, y, width, height in pixels
+  float confidence = 0.0f;
+};
+
+struct Detections {
+  std::vector<PersonBox> boxes;  // after NMS
+  std::vector<PersonBox> raw;    // every box above the confidence threshold, before NMS
+  double time_ms = 0.0;          // time spent in detect() (network forward and decoding)
+};
+
+struct DetectorOptions {
+  int input_size = 160;     // square network input, multiple of 32 and >= 32
+  double confidence = 0.2;  // boxes with a person score below this are dropped
+  double nms = 0.1;         // IoU threshold of non-maximum suppression
+  int person_class = 0;     // class index of "person" in the model's output
+  // DarknetDetector: when > 0, cv::setNumThreads(opencv_threads) is called when the detector is created.
+  // OpenCV DNN parallelises layers with cv::parallel_for_, and that setting is PROCESS-WIDE (it also
+  // affects cv::resize etc. in every thread). Default 1: the detector runs on its own thread beside ORB
+  // extraction, so one core each is what a 2-core machine wants. 0 = leave OpenCV's setting alone (the
+  // SLAM system / caller decides).
+  int opencv_threads = 1;
+
+  void check() const;  // throws InputError naming the bad value
+};
+
+class PersonDetector {
+ public:
+  PersonDetector() = default;
+  virtual ~PersonDetector() = default;
+  PersonDetector(const PersonDetector&) = delete;
+  PersonDetector& operator=(const PersonDetector&) = delete;
+
+  // Detects people in an 8-bit BGR (or grey) image. frame_index is the 0-based frame number in the
+  // sequence (file-based detectors look boxes up by it; network detectors ignore it).
+  virtual Detections detect(const cv::Mat& bgr, std::size_t frame_index) = 0;
+  [[nodiscard]] virtual std::string name() const = 0;
+};
+
+// Clips a box to [0, width) x [0, height). Returns an empty rect (width or height <= 0) when nothing is
+// left; NaN coordinates give an empty rect too.
+cv::Rect2f clip_box(const cv::Rect2f& box, int width, int height);
+
+// Intersection over union (0 for empty boxes).
+double box_iou(const cv::Rect2f& a, const cv::Rect2f& b);
+
+// Non-maximum suppression (cv::dnn::NMSBoxes with score threshold `confidence` and IoU threshold `nms`);
+// keeps the order of decreasing confidence.
+std::vector<PersonBox> suppress_non_maxima(const std::vector<PersonBox>& boxes, double confidence,
+                                           double nms);
+
+}  // namespace crowdslam::people

@@ -1,0 +1,91 @@
+#include "crowdslam/people/keypoint_filter.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::people {
+
+FilterMode parse_filter_mode(const std::string& name, const std::string& key) {
+  if (name == "paper") return FilterMode::kPaper;
+  if (name == "depth") return FilterMode::kDepth;
+  throw InputError(key + ": unknown people filter mode '" + name + "' (expected paper or depth)");
+}
+
+const char* to_string(FilterMode mode) { return mode == FilterMode::kPaper ? "paper" : "depth"; }
+
+void KeypointFilterOptions::check() const {
+  if (!(margin_px >= 0))
+    throw InputError("PeopleFilter.margin_px must be >= 0, got " + std::to_string(margin_px));
+  if (!(depth_margin_m >= 0)) {
+    throw InputError("PeopleFilter.depth_margin_m must be >= 0, got " + std::to_string(depth_margin_m));
+  }
+}
+
+double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box) {
+  if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1) return -1.0;
+  // Central region: half the width, 70% of the height.
+  const cv::Rect2f centre(box.x + 0.25f * box.width, box.y + 0.15f * box.height, 0.5f * box.width,
+                          0.7f * box.height);
+  const cv::Rect region =
+      cv::Rect(cv::Point(cvFloor(centre.x), cvFloor(centre.y)),
+               cv::Point(cvCeil(centre.x + centre.width), cvCeil(centre.y + centre.height))) &
+      cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
+  if (region.area() <= 0) return -1.0;
+  // Subsample to at most ~2000 values: the estimate does not need every pixel.
+  const int step = std::max(1, static_cast<int>(std::sqrt(region.area() / 2000.0)));
+  std::vector<uint16_t> values;
+  for (int y = region.y; y < region.y + region.height; y += step) {
+    const auto* row = depth_image_raw.ptr<uint16_t>(y);
+    for (int x = region.x; x < region.x + region.width; x += step) {
+      if (row[x] > 0) values.push_back(row[x]);
+    }
+  }
+  if (values.size() < 10) return -1.0;
+  const auto nth = values.begin() + static_cast<long>(values.size() * 3 / 10);
+  std::nth_element(values.begin(), nth, values.end());
+  return *nth / depth_factor;
+}
+
+FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const std::vector<PersonBox>& boxes,
+                              const KeypointFilterOptions& options, const std::vector<float>& depth_m,
+                              const cv::Mat& depth_image_raw, double depth_factor) {
+  FilterResult result;
+  result.keep.assign(keypoints.size(), true);
+  if (boxes.empty()) return result;
+  const float margin = static_cast<float>(options.margin_px);
+  std::vector<cv::Rect2f> grown;
+  grown.reserve(boxes.size());
+  for (const auto& b : boxes) {
+    // Zero, negative or non-finite boxes are ignored (NaN fails every comparison, so check explicitly).
+    if (!(b.box.width > 0) || !(b.box.height > 0) || !std::isfinite(b.box.x) || !std::isfinite(b.box.y) ||
+        !std::isfinite(b.box.width) || !std::isfinite(b.box.height)) {
+      continue;
+    }
+    grown.emplace_back(b.box.x - margin, b.box.y - margin, b.box.width + 2 * margin,
+                       b.box.height + 2 * margin);
+    if (options.mode == FilterMode::kDepth) {
+      result.person_depth_m.push_back(estimate_person_depth(depth_image_raw, depth_factor, b.box));
+    }
+  }
+  const bool use_depth = options.mode == FilterMode::kDepth && depth_m.size() == keypoints.size();
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const cv::Point2f& p = keypoints[i].pt;
+    for (size_t b = 0; b < grown.size(); ++b) {
+      const cv::Rect2f& r = grown[b];
+      if (p.x < r.x || p.y < r.y || p.x >= r.x + r.width || p.y >= r.y + r.height) continue;
+      if (use_depth) {
+        const double person = result.person_depth_m[b];
+        // Clearly behind the person: background seen past them, keep (it may still be in another box).
+        if (person > 0 && depth_m[i] > person + options.depth_margin_m) continue;
+      }
+      result.keep[i] = false;
+      ++result.removed;
+      break;
+    }
+  }
+  return result;
+}
+
+}  // namespace crowdslam::people

@@ -1,0 +1,44 @@
+#pragma once
+// The people filter: decides which keypoints to keep given the person boxes of the frame.
+//
+// Paper mode (Crowd-SLAM): every keypoint inside any box grown by `margin_px` is dropped. Boxes are tested
+// directly (no per-pixel mask), so the cost is keypoints x boxes, independent of the image size.
+// Depth mode (our extension, RGB-D/stereo): inside a box, only keypoints at the person's depth (or without
+// depth) are dropped; background clearly behind the person (by more than `depth_margin_m`) is kept.
+// The person's depth is a robust estimate from the depth values in the box's central region.
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "crowdslam/people/detector.h"
+
+namespace crowdslam::people {
+
+enum class FilterMode { kPaper, kDepth };
+FilterMode parse_filter_mode(const std::string& name, const std::string& key);
+const char* to_string(FilterMode mode);
+
+struct KeypointFilterOptions {
+  FilterMode mode = FilterMode::kPaper;
+  double margin_px = 5.0;       // boxes grown by this on every side
+  double depth_margin_m = 0.5;  // depth mode: keep keypoints this much behind the person
+  void check() const;
+};
+
+struct FilterResult {
+  std::vector<bool> keep;  // one flag per keypoint
+  int removed = 0;
+  std::vector<double> person_depth_m;  // depth mode: per box (<= 0: unknown, whole box filtered)
+};
+
+// depth_m: per-keypoint depth in metres (<= 0 = none); ignored in paper mode (may be empty).
+// depth_image_raw + depth_factor: used in depth mode to estimate each person's depth.
+FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const std::vector<PersonBox>& boxes,
+                              const KeypointFilterOptions& options, const std::vector<float>& depth_m = {},
+                              const cv::Mat& depth_image_raw = cv::Mat(), double depth_factor = 5000.0);
+
+// Robust depth of the person in `box`: the 30th percentile of the valid depths in its central region
+// (people stand in front of what their box also contains). Returns <= 0 when there is no depth there.
+double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box);
+
+}  // namespace crowdslam::people

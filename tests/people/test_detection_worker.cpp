@@ -1,0 +1,129 @@
+// DetectionWorker: right frame back, blocking wait, exceptions, shutdown.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "crowdslam/people/detection_worker.h"
+
+namespace crowdslam::people {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Returns one box whose x is the frame index and whose width is the image's first pixel value; sleeps
+// `delay` first; throws on frame `throw_on`.
+class FakeDetector : public PersonDetector {
+ public:
+  FakeDetector(std::chrono::milliseconds delay, std::size_t throw_on = SIZE_MAX)
+      : delay_(delay), throw_on_(throw_on) {}
+  Detections detect(const cv::Mat& bgr, std::size_t frame_index) override {
+    started.store(true);
+    std::this_thread::sleep_for(delay_);
+    if (frame_index == throw_on_)
+      throw std::runtime_error("fake failure on frame " + std::to_string(frame_index));
+    Detections d;
+    d.boxes.push_back({{static_cast<float>(frame_index), 0, static_cast<float>(bgr.at<uchar>(0, 0)), 1}, 1});
+    calls.fetch_add(1);
+    return d;
+  }
+  std::string name() const override { return "fake"; }
+  std::atomic<int> calls{0};
+  std::atomic<bool> started{false};
+
+ private:
+  std::chrono::milliseconds delay_;
+  std::size_t throw_on_;
+};
+
+cv::Mat image_with(int value) { return cv::Mat(4, 4, CV_8UC1, cv::Scalar(value)); }
+
+TEST(DetectionWorker, ResultsComeBackForTheRightFrame) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(0ms));
+  for (std::size_t k = 0; k < 20; ++k) {
+    worker.submit(k, image_with(static_cast<int>(k + 7)));
+    const WorkerResult r = worker.wait(k);
+    EXPECT_EQ(r.frame_index, k);
+    ASSERT_EQ(r.detections.boxes.size(), 1u);
+    EXPECT_FLOAT_EQ(r.detections.boxes[0].box.x, static_cast<float>(k));
+    EXPECT_FLOAT_EQ(r.detections.boxes[0].box.width, static_cast<float>(k + 7));
+  }
+}
+
+TEST(DetectionWorker, WaitBlocksUntilTheSlowDetectorIsDone) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(150ms));
+  const auto start = std::chrono::steady_clock::now();
+  worker.submit(3, image_with(1));
+  const auto submitted = std::chrono::steady_clock::now();
+  EXPECT_LT(submitted - start, 100ms);  // submit returns at once
+  const WorkerResult r = worker.wait(3);
+  const auto elapsed = std::chrono::steady_clock::now() - start;
+  EXPECT_GE(elapsed, 150ms);
+  EXPECT_GE(r.waited_ms, 100.0);
+  EXPECT_EQ(r.detections.boxes.size(), 1u);
+}
+
+TEST(DetectionWorker, WaitAfterTheResultIsReadyDoesNotBlock) {
+  auto detector = std::make_unique<FakeDetector>(0ms);
+  FakeDetector* fake = detector.get();
+  DetectionWorker worker(std::move(detector));
+  worker.submit(0, image_with(1));
+  while (fake->calls.load() == 0) std::this_thread::sleep_for(1ms);
+  std::this_thread::sleep_for(20ms);
+  EXPECT_LT(worker.wait(0).waited_ms, 15.0);
+}
+
+TEST(DetectionWorker, DetectorExceptionReachesWaitAndWorkerStaysUsable) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(0ms, 1));
+  worker.submit(0, image_with(1));
+  EXPECT_EQ(worker.wait(0).detections.boxes.size(), 1u);
+  worker.submit(1, image_with(1));
+  try {
+    worker.wait(1);
+    FAIL() << "expected the detector's exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "fake failure on frame 1");
+  }
+  worker.submit(2, image_with(1));
+  EXPECT_EQ(worker.wait(2).frame_index, 2u);
+}
+
+TEST(DetectionWorker, MisuseIsALogicError) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(50ms));
+  EXPECT_THROW(worker.wait(0), std::logic_error);  // nothing submitted
+  worker.submit(0, image_with(1));
+  EXPECT_THROW(worker.submit(1, image_with(1)), std::logic_error);  // frame 0 still in flight
+  EXPECT_THROW(worker.wait(5), std::logic_error);                   // not the submitted frame
+  EXPECT_EQ(worker.wait(0).frame_index, 0u);
+}
+
+TEST(DetectionWorker, ShutdownWhileIdle) {
+  const auto start = std::chrono::steady_clock::now();
+  { DetectionWorker worker(std::make_unique<FakeDetector>(0ms)); }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 1s);
+}
+
+TEST(DetectionWorker, ShutdownWhileADetectionIsRunning) {
+  auto detector = std::make_unique<FakeDetector>(100ms);
+  FakeDetector* fake = detector.get();
+  const auto start = std::chrono::steady_clock::now();
+  {
+    DetectionWorker worker(std::move(detector));
+    worker.submit(0, image_with(1));
+    while (!fake->started.load()) std::this_thread::sleep_for(1ms);
+  }  // destructor joins after the running detection
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 100ms);
+}
+
+TEST(DetectionWorker, ShutdownWithASubmittedFrameNeverCollected) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(10ms));
+  worker.submit(0, image_with(1));
+  // No wait(): the destructor must still return.
+}
+
+}  // namespace
+}  // namespace crowdslam::people
