@@ -28,6 +28,14 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
   cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)");
+  cmd->add_flag("!--no-people-filter", args->options.people_filter,
+                "Run without the people filter and without the feature-number update (static-world baseline)");
+  cmd->add_option("--detections", args->options.detections_file,
+                  "Person boxes from a MOT-format file (frame,id,x,y,w,h,conf,...) instead of the detector");
+  cmd->add_option("--detector", args->options.detector_model, "Detector model: body, coco, PATH.cfg or PATH.onnx");
+  cmd->add_option("--filter-mode", args->options.filter_mode, "People filter mode: paper or depth");
+  cmd->add_option("--save-frames", args->options.save_frames,
+                  "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
   cmd->callback([args, &global] {
     if (!args->sensor.empty()) args->options.sensor = io::parse_sensor_kind(args->sensor, "--sensor");
     args->options.max_frames = args->frames;

@@ -75,9 +75,11 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.flag("PeopleFilter.enabled"), s.people_filter.enabled);
   set_if(r.text("PeopleFilter.mode"), s.people_filter.mode);
   set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
+  set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
   set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
   set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);
+  set_if(r.text("FeatureBudget.area"), s.feature_budget.area);
   set_if(r.text("Output.trajectory_format"), s.output.trajectory_format);
 }
 
@@ -147,10 +149,12 @@ bool operator==(const Settings& a, const Settings& b) {
                         da.filter_before_nms == db.filter_before_nms;
   const bool people = a.people_filter.enabled == b.people_filter.enabled &&
                       a.people_filter.mode == b.people_filter.mode &&
-                      a.people_filter.margin_px == b.people_filter.margin_px;
+                      a.people_filter.margin_px == b.people_filter.margin_px &&
+                      a.people_filter.depth_margin_m == b.people_filter.depth_margin_m;
   const bool budget = a.feature_budget.enabled == b.feature_budget.enabled &&
                       a.feature_budget.thresholds == b.feature_budget.thresholds &&
-                      a.feature_budget.factors == b.feature_budget.factors;
+                      a.feature_budget.factors == b.feature_budget.factors &&
+                      a.feature_budget.area == b.feature_budget.area;
   return camera && orb && detector && people && budget && a.th_depth == b.th_depth &&
          a.depth_map_factor == b.depth_map_factor &&
          a.output.trajectory_format == b.output.trajectory_format &&

@@ -66,12 +66,14 @@ struct PeopleFilterSettings {
   bool enabled = true;
   std::string mode = "paper";  // "paper" | "depth"
   double margin_px = 5.0;
+  double depth_margin_m = 0.5;  // "depth" mode: keypoints this far behind the person are kept
 };
 
 struct FeatureBudgetSettings {
   bool enabled = true;
   std::vector<double> thresholds{0.0, 0.3, 0.6, 0.9, 0.95};
   std::vector<double> factors{1.0, 1.3, 1.5, 1.7, 1.9, 2.2};
+  std::string area = "sum";  // "sum" of box areas (paper) or "union" of the boxes
   // Factor for the fraction of the image covered by people: a <= thresholds[0] -> factors[0],
   // a < thresholds[i] -> factors[i], else factors.back().
   [[nodiscard]] double factor_for(double people_area_fraction) const;

@@ -128,6 +128,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(p.mode == "paper" || p.mode == "depth", "PeopleFilter.mode", "\"paper\" or \"depth\"",
             "\"" + p.mode + "\"");
   c.require(std::isfinite(p.margin_px) && p.margin_px >= 0, "PeopleFilter.margin_px", ">= 0", p.margin_px);
+  c.require(std::isfinite(p.depth_margin_m) && p.depth_margin_m >= 0, "PeopleFilter.depth_margin_m", ">= 0",
+            p.depth_margin_m);
   const auto& b = s.feature_budget;
   if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
   for (std::size_t i = 0; i < b.thresholds.size(); ++i) {
@@ -142,6 +144,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
                                         std::to_string(b.thresholds.size() + 1) + "), got " +
                                         std::to_string(b.factors.size()));
   for (const double f : b.factors) c.positive(f, "FeatureBudget.factors");
+  c.require(b.area == "sum" || b.area == "union", "FeatureBudget.area", "\"sum\" or \"union\"",
+            "\"" + b.area + "\"");
   const auto& format = s.output.trajectory_format;
   c.require(format == "tum" || format == "kitti" || format == "euroc", "Output.trajectory_format",
             "\"tum\", \"kitti\" or \"euroc\"", "\"" + format + "\"");

@@ -89,12 +89,13 @@ void write_own_sections(std::ostream& out, const Settings& s) {
   const auto& p = s.people_filter;
   out << "# Keypoints on people (mode \"paper\" or \"depth\")\nPeopleFilter.enabled: " << (p.enabled ? 1 : 0)
       << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
-      << "\n\n";
+      << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m) << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "
       << (b.enabled ? 1 : 0) << "\nFeatureBudget.thresholds: " << list_text(b.thresholds)
-      << "\nFeatureBudget.factors: " << list_text(b.factors) << "\n\n";
+      << "\nFeatureBudget.factors: " << list_text(b.factors) << "\nFeatureBudget.area: " << quoted(b.area)
+      << "\n\n";
   out << "# Output\nOutput.trajectory_format: " << quoted(s.output.trajectory_format) << "\n";
 }
 

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "crowdslam/eval/ate.h"
 #include "crowdslam/eval/rpe.h"
@@ -35,12 +38,36 @@ io::TrajectoryFormat parse_format(const std::string& name) {
   return io::TrajectoryFormat::kTum;
 }
 
+cv::Mat draw_frame(const cv::Mat& colour, const FrameReport& r) {
+  cv::Mat canvas;
+  if (colour.channels() == 1) {
+    cv::cvtColor(colour, canvas, cv::COLOR_GRAY2BGR);
+  } else {
+    canvas = colour.clone();
+  }
+  for (const auto& b : r.boxes) cv::rectangle(canvas, b.box, cv::Scalar(255, 80, 0), 2);
+  for (const auto& k : r.kept_keypoints) cv::circle(canvas, k.pt, 3, cv::Scalar(0, 200, 0), 1);
+  for (const auto& k : r.removed_keypoints) cv::circle(canvas, k.pt, 3, cv::Scalar(0, 0, 255), 1);
+  const std::string text = "frame " + std::to_string(r.index) + "  boxes " + std::to_string(r.person_boxes) +
+                           "  kept " + std::to_string(r.kept_keypoints.size()) + "  removed " +
+                           std::to_string(r.removed_keypoints.size()) + "  budget " +
+                           std::to_string(r.feature_budget) + "  " + tracking::to_string(r.state);
+  cv::putText(canvas, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 2);
+  cv::putText(canvas, text, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
+  return canvas;
+}
+
 nlohmann::json frame_json(const FrameReport& r) {
   return {{"index", r.index},
+          {"person_boxes", r.person_boxes},
+          {"people_area", r.people_area},
+          {"keypoints_before_filter", r.keypoints_before_filter},
+          {"detector_ms", r.detector_ms},
+          {"detector_wait_ms", r.detector_wait_ms},
           {"timestamp", r.timestamp_s},
           {"extraction_ms", r.extraction_ms},
           {"tracking_ms", r.tracking_ms},
-          {"total_ms", r.extraction_ms + r.tracking_ms},
+          {"total_ms", r.extraction_ms + r.detector_wait_ms + r.tracking_ms},
           {"keypoints", r.keypoints},
           {"feature_budget", r.feature_budget},
           {"tracked_points", r.tracked_points},
@@ -69,10 +96,20 @@ RunSummary run_sequence(const RunOptions& options) {
   const io::Settings settings = io::load_settings(settings_path, sensor);
   if (options.out_dir.empty()) throw InputError("--out: output directory required");
 
+  io::Settings run_settings = settings;
+  if (!options.filter_mode.empty()) {
+    run_settings.people_filter.mode = options.filter_mode;
+    run_settings.check(sensor);
+  }
   SystemOptions system_options;
   system_options.sensor = sensor;
   system_options.sequential = options.sequential;
-  System slam(settings, system_options);
+  system_options.people_filter = options.people_filter;
+  system_options.detections_file = options.detections_file;
+  system_options.detector_model = options.detector_model;
+  system_options.record_keypoints = options.save_frames > 0;
+  System slam(run_settings, system_options);
+  std::vector<std::pair<size_t, std::vector<uchar>>> saved_frames;  // encoded JPEGs, written at the end
 
   std::vector<FrameReport> reports;
   std::vector<double> load_ms;  // time tracking waited for the next decoded frame
@@ -85,6 +122,13 @@ RunSummary run_sequence(const RunOptions& options) {
     if (!frame) break;
     load_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start).count());
     reports.push_back(slam.track(frame->images, frame->info.timestamp_s));
+    if (options.save_frames > 0 && reports.back().index % options.save_frames == 0) {
+      std::vector<uchar> jpeg;
+      cv::imencode(".jpg", draw_frame(frame->images.colour, reports.back()), jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
+      saved_frames.emplace_back(reports.back().index, std::move(jpeg));
+      reports.back().kept_keypoints.clear();
+      reports.back().removed_keypoints.clear();
+    }
     if (options.progress && reports.size() % 100 == 0) {
       spdlog::info("frame {}/{}: {} keyframes, {} map points", reports.size(), expected, slam.num_keyframes(),
                    slam.num_map_points());
@@ -96,13 +140,15 @@ RunSummary run_sequence(const RunOptions& options) {
 
   RunSummary summary;
   summary.frames = reports.size();
-  std::vector<double> tracking_ms, extraction_ms, total_ms;
+  std::vector<double> tracking_ms, extraction_ms, total_ms, detector_ms, detector_wait_ms;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& r : reports) {
     if (r.state == tracking::TrackingState::kOk) ++summary.tracked;
     tracking_ms.push_back(r.tracking_ms);
     extraction_ms.push_back(r.extraction_ms);
-    total_ms.push_back(r.extraction_ms + r.tracking_ms);
+    total_ms.push_back(r.extraction_ms + r.detector_wait_ms + r.tracking_ms);
+    detector_ms.push_back(r.detector_ms);
+    detector_wait_ms.push_back(r.detector_wait_ms);
     frames.push_back(frame_json(r));
   }
   summary.tracked_percent = 100.0 * static_cast<double>(summary.tracked) / static_cast<double>(summary.frames);
@@ -145,6 +191,17 @@ RunSummary run_sequence(const RunOptions& options) {
   doc["settings"] = settings_path;
   doc["sensor"] = io::to_string(sensor);
   doc["mode"] = options.sequential ? "sequential" : "threaded";
+  doc["people_filter"] = slam.people_filter_enabled()
+                             ? nlohmann::json{{"detector", slam.detector_name()},
+                                              {"mode", run_settings.people_filter.mode},
+                                              {"margin_px", run_settings.people_filter.margin_px},
+                                              {"filter_before_nms", run_settings.detector.filter_before_nms},
+                                              {"feature_budget", run_settings.feature_budget.enabled},
+                                              {"area", run_settings.feature_budget.area},
+                                              {"detector_ms_median", percentile(detector_ms, 0.5)},
+                                              {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
+                                              {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
+                             : nlohmann::json(nullptr);
   doc["summary"] = {{"frames", summary.frames},
                     {"tracked_frames", summary.tracked},
                     {"tracked_percent", summary.tracked_percent},
@@ -183,6 +240,18 @@ RunSummary run_sequence(const RunOptions& options) {
   const auto format = parse_format(settings.output.trajectory_format);
   io::write_trajectory((out / "CameraTrajectory.txt").string(), camera_trajectory, format);
   io::write_trajectory((out / "KeyFrameTrajectory.txt").string(), keyframe_trajectory, format);
+  if (!saved_frames.empty()) {
+    const auto frames_dir = out / "frames";
+    std::filesystem::create_directories(frames_dir, ec);
+    if (ec) throw input_error(frames_dir.string(), "cannot create directory: " + ec.message());
+    for (const auto& [index, jpeg] : saved_frames) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%06zu.jpg", index);
+      AtomicFile file(frames_dir / name);
+      file.stream().write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
+      file.commit();
+    }
+  }
   write_file_atomic(out / "run.json", doc.dump(1) + "\n");
   return summary;
 }

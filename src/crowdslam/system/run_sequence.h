@@ -4,6 +4,8 @@
 //   OUT/KeyFrameTrajectory.txt  the keyframes left in the map
 //   OUT/run.json                settings used, per-frame timings and states, summary, accuracy when ground
 //                               truth is available
+//   OUT/frames/NNNNNN.jpg       with --save-frames N: every N-th frame with person boxes (blue), kept
+//                               keypoints (green) and keypoints removed by the people filter (red)
 // Files are written only when the run completes (each atomically); a failed run leaves nothing behind.
 #include <optional>
 #include <string>
@@ -22,6 +24,11 @@ struct RunOptions {
   bool sequential = false;
   size_t max_frames = 0;  // 0 = all
   bool progress = true;
+  bool people_filter = true;        // --no-people-filter: static-world baseline (no filter, no FNU)
+  std::string detections_file;      // --detections: MOT-format boxes instead of the network
+  std::string detector_model;       // --detector: body | coco | PATH.cfg | PATH.onnx
+  std::string filter_mode;          // --filter-mode: overrides PeopleFilter.mode (paper | depth)
+  size_t save_frames = 0;           // --save-frames N: every N-th frame drawn into OUT/frames/
 };
 
 struct RunSummary {

@@ -6,6 +6,9 @@
 
 #include "crowdslam/feature/orb_extractor.h"
 #include "crowdslam/map/keyframe.h"
+#include "crowdslam/people/darknet_detector.h"
+#include "crowdslam/people/model_paths.h"
+#include "crowdslam/people/mot_file_detector.h"
 
 namespace crowdslam::system {
 
@@ -53,7 +56,98 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracker_options.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   tracker_ = std::make_unique<tracking::Tracker>(tracker_options, map_, mapper_.get());
 
+  next_feature_budget_ = frame_builder_->default_num_features();
+  if (options.people_filter && settings.people_filter.enabled) start_people_filter(settings);
   if (!options.sequential) mapper_->start();
+}
+
+void System::start_people_filter(const io::Settings& settings) {
+  people::DetectorOptions detector_options;
+  detector_options.input_size = settings.detector.input_size;
+  detector_options.confidence = settings.detector.confidence;
+  detector_options.nms = settings.detector.nms;
+  detector_options.person_class = settings.detector.person_class;
+  std::unique_ptr<people::PersonDetector> detector;
+  if (!options_.detections_file.empty()) {
+    detector = std::make_unique<people::MotFileDetector>(options_.detections_file, detector_options);
+  } else {
+    std::string spec = options_.detector_model.empty() ? settings.detector.model_cfg : options_.detector_model;
+    if (spec.empty()) spec = "body";
+    people::ModelFiles model = people::resolve_model(spec);
+    if (!settings.detector.model_weights.empty() && options_.detector_model.empty()) {
+      model.weights = settings.detector.model_weights;
+    }
+    if (spec != "body" && spec != "coco") model.person_class = settings.detector.person_class;
+    detector_options.person_class = model.person_class;
+    detector = std::make_unique<people::DarknetDetector>(model, detector_options);
+  }
+  detection_worker_ = std::make_unique<people::DetectionWorker>(std::move(detector));
+
+  filter_options_.mode = people::parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
+  filter_options_.margin_px = settings.people_filter.margin_px;
+  filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
+  filter_options_.check();
+  filter_before_nms_ = settings.detector.filter_before_nms;
+
+  budget_options_.base_features = settings.orb.n_features;
+  budget_options_.enabled = settings.feature_budget.enabled;
+  budget_options_.thresholds = settings.feature_budget.thresholds;
+  budget_options_.factors = settings.feature_budget.factors;
+  area_mode_ = settings.feature_budget.area == "union" ? people::AreaMode::kUnion : people::AreaMode::kSum;
+}
+
+std::string System::detector_name() const {
+  return detection_worker_ ? detection_worker_->detector().name() : std::string("none");
+}
+
+void System::filter_people(size_t frame_index, const io::FrameImages& images, tracking::RawFeatures& raw,
+                           FrameReport& report) {
+  const people::WorkerResult result = detection_worker_->wait(frame_index);
+  const auto& boxes = filter_before_nms_ ? result.detections.raw : result.detections.boxes;
+  report.detector_ms = result.detections.time_ms;
+  report.detector_wait_ms = result.waited_ms;
+  report.person_boxes = static_cast<int>(result.detections.boxes.size());
+  report.keypoints_before_filter = static_cast<int>(raw.keys.size());
+
+  std::vector<float> depth_m;
+  const bool rgbd = options_.sensor == io::SensorKind::kRgbd && !images.depth.empty();
+  if (filter_options_.mode == people::FilterMode::kDepth && rgbd) {
+    depth_m.resize(raw.keys.size(), -1.0f);
+    for (size_t i = 0; i < raw.keys.size(); ++i) {
+      const int x = cvRound(raw.keys[i].pt.x);
+      const int y = cvRound(raw.keys[i].pt.y);
+      if (x < 0 || y < 0 || x >= images.depth.cols || y >= images.depth.rows) continue;
+      const uint16_t d = images.depth.at<uint16_t>(y, x);
+      if (d > 0) depth_m[i] = static_cast<float>(d / settings_.depth_map_factor);
+    }
+  }
+  const people::FilterResult filtered =
+      people::filter_keypoints(raw.keys, boxes, filter_options_, depth_m, rgbd ? images.depth : cv::Mat(),
+                               settings_.depth_map_factor > 0 ? settings_.depth_map_factor : 1.0);
+  if (filtered.removed > 0) {
+    tracking::RawFeatures kept;
+    kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));
+    kept.descriptors.create(static_cast<int>(raw.keys.size()) - filtered.removed, raw.descriptors.cols, raw.descriptors.type());
+    int row = 0;
+    for (size_t i = 0; i < raw.keys.size(); ++i) {
+      if (filtered.keep[i]) {
+        raw.descriptors.row(static_cast<int>(i)).copyTo(kept.descriptors.row(row++));
+        kept.keys.push_back(raw.keys[i]);
+      } else if (options_.record_keypoints) {
+        report.removed_keypoints.push_back(raw.keys[i]);
+      }
+    }
+    raw = std::move(kept);
+  }
+  // Feature number update for the next frame.
+  budget_options_.image_width = images.colour.cols;
+  budget_options_.image_height = images.colour.rows;
+  // The covered area always comes from the boxes kept by NMS: the raw boxes overlap heavily, and their
+  // summed area says nothing about how much of the image people cover.
+  report.people_area =
+      people::covered_fraction(result.detections.boxes, images.colour.cols, images.colour.rows, area_mode_);
+  next_feature_budget_ = people::feature_budget(report.people_area, budget_options_);
+  report.boxes = boxes;
 }
 
 System::~System() { shutdown(); }
@@ -69,14 +163,21 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.index = next_frame_id_;
   report.timestamp_s = timestamp_s;
 
+  const size_t frame_index = next_frame_id_;
+  // The detector works on this frame on its own thread while ORB features are extracted here.
+  if (detection_worker_) detection_worker_->submit(frame_index, images.colour);
   const auto extraction_start = std::chrono::steady_clock::now();
   const cv::Mat gray = feature::to_gray(images.colour);
   tracking::RawFeatures raw;
-  report.feature_budget = frame_builder_->default_num_features();
+  report.feature_budget = next_feature_budget_;
   frame_builder_->extract(gray, report.feature_budget, raw);
+  report.keypoints_before_filter = static_cast<int>(raw.keys.size());
+  if (detection_worker_) filter_people(frame_index, images, raw, report);
   const cv::Mat depth = options_.sensor == io::SensorKind::kRgbd ? images.depth : cv::Mat();
+  if (options_.record_keypoints) report.kept_keypoints = raw.keys;
   auto features = frame_builder_->assemble(std::move(raw), depth);
-  report.extraction_ms = elapsed_ms(extraction_start);
+  // Extraction time excludes the wait for the detector (reported on its own).
+  report.extraction_ms = elapsed_ms(extraction_start) - report.detector_wait_ms;
   report.keypoints = static_cast<int>(features->size());
 
   const auto tracking_start = std::chrono::steady_clock::now();

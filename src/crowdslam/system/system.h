@@ -9,6 +9,9 @@
 #include "crowdslam/io/settings.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/mapping/local_mapper.h"
+#include "crowdslam/people/detection_worker.h"
+#include "crowdslam/people/feature_budget.h"
+#include "crowdslam/people/keypoint_filter.h"
 #include "crowdslam/tracking/frame_builder.h"
 #include "crowdslam/tracking/tracker.h"
 
@@ -17,6 +20,12 @@ namespace crowdslam::system {
 struct SystemOptions {
   io::SensorKind sensor = io::SensorKind::kRgbd;
   bool sequential = false;  // local mapping inline after each frame: reproducible runs
+  // People filter and feature-number update (settings PeopleFilter.enabled can turn them off too).
+  bool people_filter = true;
+  // Person boxes from a MOT-format file instead of the network (frame n of the file = frame n-1 here).
+  std::string detections_file;
+  std::string detector_model;  // overrides Detector.model_cfg: "body", "coco", a .cfg or .onnx path
+  bool record_keypoints = false;  // fill FrameReport::kept_keypoints / removed_keypoints (for drawing)
 };
 
 // What happened to one frame, for run.json.
@@ -31,6 +40,15 @@ struct FrameReport {
   tracking::TrackingState state = tracking::TrackingState::kNotInitialized;
   std::string method;
   bool new_keyframe = false;
+  // People filter.
+  int person_boxes = 0;
+  double people_area = 0;      // fraction of the image covered (sum or union, FeatureBudget.area)
+  int keypoints_before_filter = 0;
+  double detector_ms = 0;      // detector forward time (runs on its own thread)
+  double detector_wait_ms = 0; // how long tracking waited for the boxes after ORB extraction
+  std::vector<people::PersonBox> boxes;  // used for filtering (for --save-frames)
+  std::vector<cv::KeyPoint> removed_keypoints;  // only with SystemOptions::record_keypoints
+  std::vector<cv::KeyPoint> kept_keypoints;
 };
 
 class System {
@@ -53,6 +71,8 @@ class System {
   [[nodiscard]] size_t num_map_points() const;
   [[nodiscard]] mapping::LocalMapperStats mapper_stats() const;
   [[nodiscard]] int map_resets() const { return map_resets_; }
+  [[nodiscard]] bool people_filter_enabled() const { return detection_worker_ != nullptr; }
+  [[nodiscard]] std::string detector_name() const;
 
  private:
   struct TrajectoryRecord {
@@ -62,6 +82,10 @@ class System {
     bool tracked = false;
   };
   void reset_map();
+  void start_people_filter(const io::Settings& settings);
+  // Waits for the frame's boxes and removes the keypoints on people; updates the next frame's budget.
+  void filter_people(size_t frame_index, const io::FrameImages& images, tracking::RawFeatures& raw,
+                     FrameReport& report);
 
   io::Settings settings_;
   SystemOptions options_;
@@ -71,6 +95,12 @@ class System {
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   std::vector<TrajectoryRecord> records_;
+  std::unique_ptr<people::DetectionWorker> detection_worker_;
+  people::KeypointFilterOptions filter_options_;
+  people::FeatureBudgetOptions budget_options_;
+  people::AreaMode area_mode_ = people::AreaMode::kSum;
+  bool filter_before_nms_ = true;
+  int next_feature_budget_ = 0;
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;
   bool shut_down_ = false;
