@@ -1,0 +1,67 @@
+// End-to-end: SLAM on sequences from the synthetic generator, against their exact ground truth.
+#include <gtest/gtest.h>
+
+#include "crowdslam/synth/options.h"
+#include "crowdslam/synth/writer.h"
+#include "crowdslam/system/run_sequence.h"
+#include "test_support.h"
+
+using namespace crowdslam;
+
+namespace {
+std::filesystem::path make_sequence(const test::TempDir& tmp, int people) {
+  synth::SynthOptions options;
+  options.frames = 150;
+  options.trajectory = synth::TrajectoryKind::kLine;
+  options.people = people;
+  options.seed = 1;
+  const auto dir = tmp / ("seq" + std::to_string(people));
+  synth::write_sequence(options, dir);
+  return dir;
+}
+
+system::RunSummary run(const std::filesystem::path& dataset, const std::filesystem::path& out, bool filter,
+                       const std::string& detections = "") {
+  system::RunOptions options;
+  options.dataset = dataset.string();
+  options.out_dir = out.string();
+  options.sequential = true;
+  options.progress = false;
+  options.people_filter = filter;
+  options.detections_file = detections;
+  return system::run_sequence(options);
+}
+}  // namespace
+
+TEST(RunSynthetic, StaticSceneTrackedWithMillimetreAccuracy) {
+  test::TempDir tmp;
+  const auto dataset = make_sequence(tmp, 0);
+  const auto summary = run(dataset, tmp / "out", false);
+  EXPECT_EQ(summary.frames, 150u);
+  EXPECT_EQ(summary.tracked, 150u);
+  ASSERT_TRUE(summary.ate_rmse_m.has_value());
+  EXPECT_LT(*summary.ate_rmse_m, 0.005);  // exact depth, textured room: a few millimetres
+}
+
+TEST(RunSynthetic, PeopleFilterWithGroundTruthBoxesRemovesKeypointsOnPeople) {
+  test::TempDir tmp;
+  const auto dataset = make_sequence(tmp, 3);
+  const auto filtered = run(dataset, tmp / "filtered", true, (dataset / "people_gt.txt").string());
+  EXPECT_EQ(filtered.tracked, 150u);
+  ASSERT_TRUE(filtered.ate_rmse_m.has_value());
+  EXPECT_LT(*filtered.ate_rmse_m, 0.005);
+  // Keypoints are removed only in frames with boxes, and some are; the budget grows after such frames.
+  int frames_with_removal = 0;
+  int previous_boxes = 0;
+  for (const auto& f : filtered.json["frames"]) {
+    const int boxes = f["person_boxes"].get<int>();
+    const int removed = f["keypoints_before_filter"].get<int>() - f["keypoints"].get<int>();
+    if (boxes == 0) EXPECT_EQ(removed, 0);
+    if (removed > 0) ++frames_with_removal;
+    if (previous_boxes > 0) EXPECT_GT(f["feature_budget"].get<int>(), 1000);
+    if (previous_boxes == 0) EXPECT_EQ(f["feature_budget"].get<int>(), 1000);
+    previous_boxes = boxes;
+  }
+  EXPECT_GT(frames_with_removal, 0);
+  EXPECT_EQ(filtered.json["people_filter"]["detector"].get<std::string>().empty(), false);
+}
