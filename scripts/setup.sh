@@ -9,7 +9,7 @@ build_dir="${1:-build}"
 shift || true
 
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git ca-certificates curl
   libopencv-dev libeigen3-dev libceres-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
@@ -35,3 +35,6 @@ if [[ ! -f "$build_dir/build.ninja" ]]; then
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${CROWDSLAM_BUILD_TYPE:-Release}" "$@"
 fi
 cmake --build "$build_dir" -j "$jobs"
+
+# Person-detector models (copied from ../shared or downloaded with a SHA-256 check; never committed).
+scripts/install_models.sh >/dev/null
