@@ -65,7 +65,7 @@ TEST(ShippedSettings, TumFilesHaveThePublishedCalibration) {
     EXPECT_EQ(s.orb.ini_th_fast, 20);
     EXPECT_EQ(s.orb.min_th_fast, 7);
     EXPECT_FALSE(s.rectification.has_value());
-    EXPECT_EQ(s.people_filter.mode, "paper");
+    EXPECT_EQ(s.people_filter.mode, "depth");
   }
 }
 
@@ -138,7 +138,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.detector.model_cfg = "models/yolo \"fastest\".cfg";
   s.detector.confidence = 1.0 / 3.0;
   s.detector.filter_before_nms = false;
-  s.people_filter.mode = "depth";
+  s.people_filter.mode = "paper";
   s.feature_budget.thresholds = {0.0, 0.5};
   s.feature_budget.factors = {1.0, 1.25, 3.0};
   s.output.trajectory_format = "kitti";
