@@ -67,11 +67,13 @@ TrackResult Tracker::track(map::Frame frame) {
       ok = track_with_motion_model(frame);
       result.method = "motion";
     }
-    if (!ok) {
-      // Also the recovery path while lost (until place recognition exists): search the reference
-      // keyframe's points around the same pixels, starting from the last known pose.
+    if (!ok && state_ == TrackingState::kOk) {
       ok = track_reference_keyframe(frame);
       result.method = "reference";
+    }
+    if (!ok) {
+      ok = relocalize(frame);
+      result.method = "relocalization";
     }
     frame.reference_keyframe = reference_keyframe_;
     if (ok) ok = track_local_map(frame);
@@ -157,6 +159,30 @@ std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& 
   point->update_normal_and_depth();
   map_->add_map_point(point);
   return point;
+}
+
+// ---- relocalisation ----
+bool Tracker::relocalize(map::Frame& frame) {
+  // Candidates: the reference keyframe and its neighbours, then the most recent keyframes.
+  std::vector<std::shared_ptr<map::KeyFrame>> candidates;
+  std::unordered_set<uint64_t> seen;
+  auto add = [&](const std::shared_ptr<map::KeyFrame>& kf) {
+    if (kf && !kf->is_bad() && seen.insert(kf->id).second) candidates.push_back(kf);
+  };
+  if (reference_keyframe_) {
+    add(reference_keyframe_);
+    for (const auto& kf : reference_keyframe_->best_covisible(5)) add(kf);
+  }
+  const auto all = map_->keyframes();
+  for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 16; ++it) add(*it);
+  const auto keyframe = relocalizer_.relocalize(frame, candidates, options_.pose);
+  if (!keyframe) return false;
+  reference_keyframe_ = keyframe;
+  frame.reference_keyframe = keyframe;
+  last_relocalization_frame_id_ = frame.id;
+  velocity_.reset();
+  spdlog::debug("relocalised frame {} against keyframe {}", frame.id, keyframe->id);
+  return true;
 }
 
 // ---- frame-to-frame tracking ----

@@ -11,6 +11,7 @@
 #include "crowdslam/map/map.h"
 #include "crowdslam/optim/pose_optimizer.h"
 #include "crowdslam/tracking/keyframe_consumer.h"
+#include "crowdslam/tracking/relocalizer.h"
 
 namespace crowdslam::tracking {
 
@@ -43,7 +44,7 @@ struct TrackResult {
   bool map_reset = false;
   int tracked_points = 0;   // inliers after local-map tracking
   int keypoints = 0;
-  const char* method = "";  // "init", "motion", "reference", "lost"
+  const char* method = "";  // "init", "motion", "reference", "relocalization", "lost"
 };
 
 class Tracker {
@@ -62,6 +63,7 @@ class Tracker {
   bool track_with_motion_model(map::Frame& frame);
   bool track_reference_keyframe(map::Frame& frame);
   bool track_local_map(map::Frame& frame);
+  bool relocalize(map::Frame& frame);
   void update_last_frame();
   void replace_replaced_points(map::Frame& frame) const;
   void update_local_map(const map::Frame& frame);
@@ -74,6 +76,7 @@ class Tracker {
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
   KeyframeConsumer* mapper_;
+  Relocalizer relocalizer_;
 
   TrackingState state_ = TrackingState::kNotInitialized;
   std::optional<map::Frame> last_frame_;
