@@ -1,0 +1,158 @@
+#!/usr/bin/env bash
+# Sanitizer builds of crowdslam and end-to-end runs under them (see docs/SANITIZERS.md).
+#   scripts/sanitize.sh [address|thread|all] [--ctest]
+#     address   ASan + UBSan (and LeakSanitizer) in build-asan/
+#     thread    TSan in build-tsan/
+#     all       both (default)
+#     --ctest   also build the e2e test executables and run `ctest -L e2e` in the sanitizer build dir
+# Every run uses the default threaded mode (tracking + detection worker + local mapping + frame
+# prefetcher). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are
+# also grepped for reports as a second check).
+# Environment: CROWDSLAM_JOBS (default 2), CROWDSLAM_SANITIZE_OUT (default out/sanitize),
+#   CROWDSLAM_SANITIZE_BUILD_TYPE (default RelWithDebInfo), CROWDSLAM_SHARED (default ../shared),
+#   CROWDSLAM_SANITIZE_FRAMES (synthetic frames, default 120), CROWDSLAM_SANITIZE_BONN_FRAMES (default 150).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root="$(pwd)"
+
+which="all"
+run_ctest=0
+for arg in "$@"; do
+  case "$arg" in
+    address | thread | all) which="$arg" ;;
+    --ctest) run_ctest=1 ;;
+    -h | --help)
+      sed -n '2,14p' "$0"
+      exit 0
+      ;;
+    *)
+      echo "sanitize.sh: unknown argument '$arg' (expected address, thread, all or --ctest)" >&2
+      exit 2
+      ;;
+  esac
+done
+
+jobs="${CROWDSLAM_JOBS:-2}"
+out_root="${CROWDSLAM_SANITIZE_OUT:-$root/out/sanitize}"
+build_type="${CROWDSLAM_SANITIZE_BUILD_TYPE:-RelWithDebInfo}"
+shared="${CROWDSLAM_SHARED:-$root/../shared}"
+synth_frames="${CROWDSLAM_SANITIZE_FRAMES:-120}"
+bonn_frames="${CROWDSLAM_SANITIZE_BONN_FRAMES:-150}"
+bonn="$shared/data/bonn_crowd"
+
+# Patterns of sanitizer reports (second line of defence besides the exit code).
+report_pattern='ERROR: AddressSanitizer|ERROR: LeakSanitizer|WARNING: ThreadSanitizer|runtime error:|SUMMARY: (Address|Thread|UndefinedBehavior|Leak)Sanitizer'
+
+failures=()
+summary=()
+
+log() { printf '[sanitize] %s\n' "$*"; }
+
+# Runs one step with its output in LOG; fails (returns 1) on a non-zero exit or a sanitizer report.
+run_step() {
+  local name="$1" logfile="$2"
+  shift 2
+  local start end rc=0
+  start=$(date +%s)
+  log "$name: $*"
+  "$@" >"$logfile" 2>&1 || rc=$?
+  end=$(date +%s)
+  if ((rc == 0)) && grep -Eq "$report_pattern" "$logfile"; then rc=99; fi
+  if ((rc != 0)); then
+    log "$name: FAILED (exit $rc, $((end - start)) s), log $logfile"
+    grep -E -m1 -A60 "$report_pattern" "$logfile" || tail -n 40 "$logfile"
+    failures+=("$name")
+    summary+=("$name: FAILED exit $rc ($((end - start)) s)")
+    return 1
+  fi
+  log "$name: ok ($((end - start)) s)"
+  summary+=("$name: ok ($((end - start)) s)")
+}
+
+# Sanitizer runtime options for SANITIZER into the environment.
+set_sanitizer_env() {
+  local sanitizer="$1"
+  unset ASAN_OPTIONS UBSAN_OPTIONS TSAN_OPTIONS LSAN_OPTIONS
+  if [[ "$sanitizer" == address ]]; then
+    export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:check_initialization_order=1:strict_init_order=1:detect_stack_use_after_return=1:abort_on_error=0"
+    export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+  else
+    export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:history_size=4"
+    # OpenCV's parallel_for_ backend here is TBB (uninstrumented); our code never runs inside it, but one
+    # OpenCV thread keeps every OpenCV call on the calling thread so TSan sees the whole picture.
+    export OPENCV_FOR_THREADS_NUM=1
+  fi
+}
+
+configure_and_build() {
+  local sanitizer="$1" build_dir="$2"
+  shift 2
+  local configured=""
+  if [[ -f "$build_dir/CMakeCache.txt" ]]; then
+    configured=$(sed -n 's/^CROWDSLAM_SANITIZE:STRING=//p' "$build_dir/CMakeCache.txt")
+  fi
+  if [[ ! -f "$build_dir/build.ninja" || "$configured" != "$sanitizer" ]]; then
+    cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DCROWDSLAM_SANITIZE="$sanitizer" \
+      -DCROWDSLAM_BUILD_BENCH=OFF >/dev/null
+  fi
+  cmake --build "$build_dir" --target "$@" -j "$jobs"
+}
+
+run_sanitizer() {
+  local sanitizer="$1" build_dir tag
+  if [[ "$sanitizer" == address ]]; then tag=asan; else tag=tsan; fi
+  build_dir="$root/build-$tag"
+  local out="$out_root/$tag"
+  rm -rf "$out"
+  mkdir -p "$out"
+  log "== $sanitizer: build in $build_dir, outputs in $out"
+  local t0
+  t0=$(date +%s)
+  configure_and_build "$sanitizer" "$build_dir" crowdslam
+  summary+=("$tag build: $(($(date +%s) - t0)) s")
+  local bin="$build_dir/apps/crowdslam/crowdslam"
+  set_sanitizer_env "$sanitizer"
+  local seq="$out/sequence"
+
+  run_step "$tag synth" "$out/synth.log" \
+    "$bin" synth --out "$seq" --frames "$synth_frames" --people 3 --trajectory handheld \
+    --width 640 --height 480 --force || return 0
+  run_step "$tag run synth (gt boxes)" "$out/run_gt.log" \
+    "$bin" run --dataset "$seq" --out "$out/run_gt" --detections "$seq/people_gt.txt" || true
+  run_step "$tag run synth (detector)" "$out/run_detector.log" \
+    "$bin" run --dataset "$seq" --out "$out/run_detector" || true
+  run_step "$tag run synth (no people filter)" "$out/run_nofilter.log" \
+    "$bin" run --dataset "$seq" --out "$out/run_nofilter" --no-people-filter || true
+  if [[ -f "$bonn/rgb.txt" ]]; then
+    run_step "$tag run bonn_crowd ($bonn_frames frames, depth filter)" "$out/run_bonn.log" \
+      "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --filter-mode depth \
+      --out "$out/run_bonn" || true
+  else
+    log "$tag: $bonn not found, skipping the Bonn run"
+    summary+=("$tag run bonn_crowd: skipped (no data)")
+  fi
+
+  if ((run_ctest)); then
+    local t1
+    t1=$(date +%s)
+    configure_and_build "$sanitizer" "$build_dir" test_cli test_system
+    summary+=("$tag test build: $(($(date +%s) - t1)) s")
+    run_step "$tag ctest -L e2e" "$out/ctest.log" \
+      ctest --test-dir "$build_dir" -L e2e --output-on-failure --timeout 1800 || true
+  fi
+  unset OPENCV_FOR_THREADS_NUM
+}
+
+case "$which" in
+  all) sanitizers=(address thread) ;;
+  *) sanitizers=("$which") ;;
+esac
+for s in "${sanitizers[@]}"; do run_sanitizer "$s"; done
+
+log "== summary"
+printf '  %s\n' "${summary[@]}"
+if ((${#failures[@]})); then
+  log "FAILED: ${failures[*]}"
+  exit 1
+fi
+log "all clean"
