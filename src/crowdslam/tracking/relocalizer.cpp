@@ -6,6 +6,7 @@
 #include "crowdslam/feature/descriptor.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/tracking/pose_refinement.h"
 
 namespace crowdslam::tracking {
 
@@ -49,24 +50,11 @@ std::vector<std::pair<size_t, std::shared_ptr<map::MapPoint>>> match_by_descript
   return matches;
 }
 
+// Optimises the pose and drops the outlier matches; returns the inliers.
 int optimize_and_count(map::Frame& frame, const optim::PoseOptimizerOptions& pose_options) {
-  const auto& f = *frame.features;
-  std::vector<optim::PoseObservation> observations;
-  std::vector<size_t> slots;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    const auto& p = frame.map_points[i];
-    if (!p) continue;
-    observations.push_back({p->world(), geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y), f.right_u[i],
-                            frame.levels->inv_sigma2[f.keys_un[i].octave]});
-    slots.push_back(i);
-  }
-  const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, observations, pose_options);
-  if (!result.success) return 0;
-  frame.cam_from_world = result.cam_from_world;
-  for (size_t k = 0; k < slots.size(); ++k) {
-    if (!result.inliers[k]) frame.map_points[slots[k]].reset();
-  }
-  return result.num_inliers;
+  const int inliers = optimize_frame_pose(frame, pose_options);
+  discard_outliers_count_map_points(frame);
+  return inliers;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::tracking {
@@ -224,27 +225,7 @@ void Tracker::update_last_frame() {
   }
 }
 
-int Tracker::optimize_pose(map::Frame& frame) const {
-  const auto& f = *frame.features;
-  std::vector<optim::PoseObservation> observations;
-  std::vector<size_t> slots;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    const auto& p = frame.map_points[i];
-    if (!p) continue;
-    optim::PoseObservation o;
-    o.point_world = p->world();
-    o.pixel = geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
-    o.right_u = f.right_u[i];
-    o.inv_sigma2 = frame.levels->inv_sigma2[f.keys_un[i].octave];
-    observations.push_back(o);
-    slots.push_back(i);
-  }
-  const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, observations, options_.pose);
-  if (!result.success) return 0;
-  frame.cam_from_world = result.cam_from_world;
-  for (size_t k = 0; k < slots.size(); ++k) frame.outliers[slots[k]] = !result.inliers[k];
-  return result.num_inliers;
-}
+int Tracker::optimize_pose(map::Frame& frame) const { return optimize_frame_pose(frame, options_.pose); }
 
 bool Tracker::track_with_motion_model(map::Frame& frame) {
   update_last_frame();
@@ -257,18 +238,7 @@ bool Tracker::track_with_motion_model(map::Frame& frame) {
   }
   if (matches < 20) return false;
   optimize_pose(frame);
-  int in_map = 0;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    auto& p = frame.map_points[i];
-    if (!p) continue;
-    if (frame.outliers[i]) {
-      p.reset();
-      frame.outliers[i] = false;
-    } else if (p->num_observations() > 0) {
-      ++in_map;
-    }
-  }
-  return in_map >= 10;
+  return discard_outliers_count_map_points(frame) >= 10;
 }
 
 bool Tracker::track_reference_keyframe(map::Frame& frame) {
@@ -278,18 +248,7 @@ bool Tracker::track_reference_keyframe(map::Frame& frame) {
   if (matches < 15) return false;
   frame.cam_from_world = *last_frame_->cam_from_world;
   optimize_pose(frame);
-  int in_map = 0;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    auto& p = frame.map_points[i];
-    if (!p) continue;
-    if (frame.outliers[i]) {
-      p.reset();
-      frame.outliers[i] = false;
-    } else if (p->num_observations() > 0) {
-      ++in_map;
-    }
-  }
-  return in_map >= 10;
+  return discard_outliers_count_map_points(frame) >= 10;
 }
 
 // ---- local map ----

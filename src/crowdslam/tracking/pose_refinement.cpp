@@ -1,0 +1,40 @@
+#include "crowdslam/tracking/pose_refinement.h"
+
+#include "crowdslam/map/map_point.h"
+
+namespace crowdslam::tracking {
+
+int optimize_frame_pose(map::Frame& frame, const optim::PoseOptimizerOptions& options) {
+  const auto& f = *frame.features;
+  std::vector<optim::PoseObservation> observations;
+  std::vector<size_t> slots;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p) continue;
+    observations.push_back({p->world(), geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y), f.right_u[i],
+                            frame.levels->inv_sigma2[f.keys_un[i].octave]});
+    slots.push_back(i);
+  }
+  const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, observations, options);
+  if (!result.success) return 0;
+  frame.cam_from_world = result.cam_from_world;
+  for (size_t k = 0; k < slots.size(); ++k) frame.outliers[slots[k]] = !result.inliers[k];
+  return result.num_inliers;
+}
+
+int discard_outliers_count_map_points(map::Frame& frame) {
+  int in_map = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!p) continue;
+    if (frame.outliers[i]) {
+      p.reset();
+      frame.outliers[i] = false;
+    } else if (p->num_observations() > 0) {
+      ++in_map;
+    }
+  }
+  return in_map;
+}
+
+}  // namespace crowdslam::tracking
