@@ -53,5 +53,13 @@ function(crowdslam_add_test)
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} crowdslam_test_support GTest::gtest_main)
   crowdslam_target_options(${target})
-  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_NAME};${ARG_LABELS}")
+  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60)
+  # Labels (module name + e.g. e2e) are set after discovery: passing a list through
+  # gtest_discover_tests(PROPERTIES LABELS ...) keeps only its first element with CMake 3.25.
+  set(labels_file "${CMAKE_CURRENT_BINARY_DIR}/${target}_labels.cmake")
+  file(WRITE "${labels_file}"
+    "foreach(test_name IN LISTS ${target}_TESTS)\n"
+    "  set_tests_properties(\"\${test_name}\" PROPERTIES LABELS \"${ARG_NAME};${ARG_LABELS}\")\n"
+    "endforeach()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_file}")
 endfunction()
