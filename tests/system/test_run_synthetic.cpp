@@ -56,10 +56,15 @@ TEST(RunSynthetic, PeopleFilterWithGroundTruthBoxesRemovesKeypointsOnPeople) {
   for (const auto& f : filtered.json["frames"]) {
     const int boxes = f["person_boxes"].get<int>();
     const int removed = f["keypoints_before_filter"].get<int>() - f["keypoints"].get<int>();
-    if (boxes == 0) EXPECT_EQ(removed, 0);
+    if (boxes == 0) {
+      EXPECT_EQ(removed, 0);
+    }
     if (removed > 0) ++frames_with_removal;
-    if (previous_boxes > 0) EXPECT_GT(f["feature_budget"].get<int>(), 1000);
-    if (previous_boxes == 0) EXPECT_EQ(f["feature_budget"].get<int>(), 1000);
+    if (previous_boxes > 0) {
+      EXPECT_GT(f["feature_budget"].get<int>(), 1000);
+    } else {
+      EXPECT_EQ(f["feature_budget"].get<int>(), 1000);
+    }
     previous_boxes = boxes;
   }
   EXPECT_GT(frames_with_removal, 0);
