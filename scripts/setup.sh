@@ -37,4 +37,7 @@ fi
 cmake --build "$build_dir" -j "$jobs"
 
 # Person-detector models (copied from ../shared or downloaded with a SHA-256 check; never committed).
-scripts/install_models.sh >/dev/null
+# Without them `crowdslam run` needs --no-people-filter or --detections, and detector tests are skipped.
+if ! scripts/install_models.sh >/dev/null; then
+  echo "setup: warning: person-detector models not installed (see the error above)" >&2
+fi
