@@ -1,0 +1,58 @@
+// `crowdslam run` error paths: a bad frame in the middle of a sequence, an unsupported sensor, bad
+// settings. Each gives one line on stderr naming the file or option, a non-zero exit, and no output.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "test_support.h"
+
+using crowdslam::test::run_cli;
+using crowdslam::test::TempDir;
+
+namespace {
+std::filesystem::path small_sequence(const TempDir& dir) {
+  const auto seq = dir / "seq";
+  const auto r = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "12", "--width", "320", "--height", "240"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return seq;
+}
+}  // namespace
+
+TEST(CliRun, TruncatedFrameMidSequenceFailsCleanlyWithoutOutput) {
+  TempDir dir;
+  const auto seq = small_sequence(dir);
+  const auto victim = seq / "rgb" / "000006.png";
+  const auto size = std::filesystem::file_size(victim);
+  std::filesystem::resize_file(victim, size / 2);
+  const auto out = dir / "out";
+  const auto r = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--no-people-filter"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("000006.png"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliRun, UnsupportedSensorAndBadSettingsAreClearErrors) {
+  TempDir dir;
+  const auto seq = small_sequence(dir);
+  const auto out = dir / "out";
+  const auto mono = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sensor", "mono"});
+  EXPECT_NE(mono.exit_code, 0);
+  EXPECT_NE(mono.err.find("monocular"), std::string::npos) << mono.err;
+
+  // A settings file with a bad value names the file and the key.
+  std::ifstream in(seq / "settings.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto pos = text.find("Camera.fx:");
+  ASSERT_NE(pos, std::string::npos);
+  text.replace(pos, text.find('\n', pos) - pos, "Camera.fx: -5.0");
+  crowdslam::test::write_text(dir / "bad.yaml", text);
+  const auto bad = run_cli({"-q", "run", "--dataset", seq.string(), "--settings", (dir / "bad.yaml").string(), "--out",
+                            out.string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("bad.yaml"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("Camera.fx"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
