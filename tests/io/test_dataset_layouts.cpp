@@ -15,15 +15,7 @@ namespace {
 using test::TempDir;
 using test::write_text;
 
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 const char* kKittiCalib =
     "P0: 700 0 600 0 0 710 180 0 0 0 1 0\n"

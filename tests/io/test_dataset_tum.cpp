@@ -14,15 +14,7 @@ using test::TempDir;
 using test::write_text;
 
 // Message of the InputError thrown by `f`, or "" when nothing is thrown.
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 TEST(TumDataset, AssociatesColourAndDepthWithinTwentyMilliseconds) {
   TempDir dir;

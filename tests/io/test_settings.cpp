@@ -13,15 +13,7 @@ namespace {
 using test::TempDir;
 using test::write_text;
 
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 std::string config(const std::string& name) { return (test::source_dir() / "config" / name).string(); }
 

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "crowdslam/util/error.h"
+
 namespace crowdslam::test {
 
 // ../shared (data and models), or $CROWDSLAM_SHARED when set.
@@ -40,6 +42,17 @@ struct CliResult {
 };
 // Runs the built `crowdslam` binary with the given arguments (no shell quoting needed).
 CliResult run_cli(const std::vector<std::string>& args);
+
+// The message of the InputError that f() throws, or "" when it throws none.
+template <typename F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace crowdslam::test
 
