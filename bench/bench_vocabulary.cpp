@@ -13,13 +13,13 @@
 #include <random>
 #include <string>
 
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 
 namespace {
 
-using crowdslam::loop::BowVector;
-using crowdslam::loop::FeatureVector;
-using crowdslam::loop::Vocabulary;
+using crowdslam::bow::BowVector;
+using crowdslam::bow::FeatureVector;
+using crowdslam::bow::Vocabulary;
 
 // Full tree of branching k and depth L in breadth-first order: node i > 0 has parent (i - 1) / k.
 std::size_t full_tree_nodes(int k, int levels) {

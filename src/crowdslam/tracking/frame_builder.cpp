@@ -11,12 +11,14 @@ void FrameBuilder::Options::check() const {
   }
 }
 
-FrameBuilder::FrameBuilder(std::shared_ptr<const geometry::PinholeCamera> camera, const Options& options)
+FrameBuilder::FrameBuilder(std::shared_ptr<const geometry::PinholeCamera> camera, const Options& options,
+                           std::shared_ptr<const bow::Vocabulary> vocabulary)
     : camera_(std::move(camera)),
       options_(options),
       extractor_(options.orb),
       levels_(std::make_shared<map::ScaleLevels>(options.orb.scale_factor, options.orb.num_levels)),
-      bounds_(camera_->undistorted_bounds()) {
+      bounds_(camera_->undistorted_bounds()),
+      vocabulary_(std::move(vocabulary)) {
   options_.check();
 }
 
@@ -53,6 +55,7 @@ std::shared_ptr<map::FrameFeatures> FrameBuilder::assemble(RawFeatures&& raw, co
     }
   }
   f->grid = map::FeatureGrid(f->keys_un, bounds_);
+  if (vocabulary_ && !vocabulary_->empty()) vocabulary_->transform(f->descriptors, f->bow, f->bow_features);
   return f;
 }
 

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/feature/orb_extractor.h"
 #include "crowdslam/geometry/camera.h"
 #include "crowdslam/map/frame_features.h"
@@ -26,7 +27,9 @@ class FrameBuilder {
     void check() const;
   };
 
-  FrameBuilder(std::shared_ptr<const geometry::PinholeCamera> camera, const Options& options);
+  // With a vocabulary, assemble() also computes each frame's bag of words and direct index.
+  FrameBuilder(std::shared_ptr<const geometry::PinholeCamera> camera, const Options& options,
+               std::shared_ptr<const bow::Vocabulary> vocabulary = nullptr);
 
   void extract(const cv::Mat& gray, int num_features, RawFeatures& out);
   // depth_raw: CV_16UC1 raw depth (0 = none) of the same size as the image, or empty (monocular).
@@ -42,6 +45,7 @@ class FrameBuilder {
   feature::ORBExtractor extractor_;
   std::shared_ptr<const map::ScaleLevels> levels_;
   geometry::ImageBounds bounds_;
+  std::shared_ptr<const bow::Vocabulary> vocabulary_;
 };
 
 }  // namespace crowdslam::tracking

@@ -9,7 +9,7 @@
 #include <map>
 #include <vector>
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 
 using WordId = std::uint32_t;
 using NodeId = std::uint32_t;
@@ -24,4 +24,4 @@ void normalize_l1(BowVector& bow);
 // 0: no word in common), symmetric. Empty vectors score 0.
 double l1_score(const BowVector& a, const BowVector& b);
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

@@ -10,7 +10,7 @@
 
 #include "crowdslam/feature/descriptor.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 
 using Descriptor = std::array<std::uint8_t, feature::kDescriptorBytes>;
 
@@ -31,4 +31,4 @@ Descriptor majority_centroid(const std::vector<const std::uint8_t*>& rows,
 BinaryClusters kmeans_binary(const std::vector<const std::uint8_t*>& rows, int k, int max_iterations,
                              std::mt19937_64& rng);
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

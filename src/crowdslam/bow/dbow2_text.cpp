@@ -10,10 +10,10 @@
 #include <sstream>
 
 #include "crowdslam/feature/descriptor.h"
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/error.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 constexpr int kFieldsPerNode = 2 + feature::kDescriptorBytes + 1;
@@ -129,4 +129,4 @@ Vocabulary Vocabulary::import_dbow2_text(const std::string& path) {
   return voc;
 }
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

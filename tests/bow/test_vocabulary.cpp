@@ -4,12 +4,12 @@
 #include <set>
 
 #include "crowdslam/feature/descriptor.h"
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/error.h"
-#include "loop_test_data.h"
+#include "bow_test_data.h"
 #include "test_support.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 using testing::clustered;
@@ -247,4 +247,4 @@ TEST_F(VocabularyFile, InconsistentTreeIsAnError) {
 }
 
 }  // namespace
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

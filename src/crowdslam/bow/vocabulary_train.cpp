@@ -5,11 +5,11 @@
 #include <random>
 #include <utility>
 
-#include "crowdslam/loop/binary_kmeans.h"
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/binary_kmeans.h"
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/error.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 // IDF weight of every word: log(N / n_w) over the images with descriptors (n_w = 0 counts as 1).
@@ -88,4 +88,4 @@ Vocabulary Vocabulary::train(const std::vector<cv::Mat>& descriptors_per_image,
   return voc;
 }
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

@@ -1,10 +1,10 @@
 #include <gtest/gtest.h>
 
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/error.h"
 #include "test_support.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 // "b b b ... b" (32 bytes) with byte `at` replaced by `other`.
@@ -110,4 +110,4 @@ TEST(Dbow2Text, BadFilesNameFileAndLine) {
 }
 
 }  // namespace
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

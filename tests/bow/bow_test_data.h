@@ -4,9 +4,9 @@
 #include <random>
 #include <vector>
 
-#include "crowdslam/loop/binary_kmeans.h"
+#include "crowdslam/bow/binary_kmeans.h"
 
-namespace crowdslam::loop::testing {
+namespace crowdslam::bow::testing {
 
 inline Descriptor random_descriptor(std::mt19937& rng) {
   Descriptor d;
@@ -43,4 +43,4 @@ inline cv::Mat clustered(const std::vector<Descriptor>& centres, int per_centre,
   return to_mat(rows);
 }
 
-}  // namespace crowdslam::loop::testing
+}  // namespace crowdslam::bow::testing

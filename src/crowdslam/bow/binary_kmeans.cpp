@@ -1,9 +1,9 @@
-#include "crowdslam/loop/binary_kmeans.h"
+#include "crowdslam/bow/binary_kmeans.h"
 
 #include <algorithm>
 #include <limits>
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 // Uniform double in [0, 1) from the raw generator (std distributions differ between libraries).
@@ -108,4 +108,4 @@ BinaryClusters kmeans_binary(const std::vector<const std::uint8_t*>& rows, int k
   return result;
 }
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

@@ -2,9 +2,9 @@
 
 #include <random>
 
-#include "crowdslam/loop/bow_vector.h"
+#include "crowdslam/bow/bow_vector.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 TEST(L1Score, IdenticalVectorsScoreOne) {
@@ -59,4 +59,4 @@ TEST(NormalizeL1, WeightsSumToOne) {
 }
 
 }  // namespace
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

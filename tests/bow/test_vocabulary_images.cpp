@@ -7,10 +7,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "crowdslam/feature/orb_extractor.h"
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 #include "test_support.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 const std::filesystem::path kOpencvData = "/usr/share/doc/opencv-doc/examples/data";
@@ -63,4 +63,4 @@ TEST(VocabularyImages, FrameScoresHigherAgainstItsOwnViewThanAgainstAFarFrame) {
 }
 
 }  // namespace
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

@@ -1,11 +1,11 @@
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 
 #include <algorithm>
 
 #include "crowdslam/feature/descriptor.h"
 #include "crowdslam/util/error.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 
 void VocabularyTrainOptions::check() const {
   const std::string where = "vocabulary training options";
@@ -142,4 +142,4 @@ void Vocabulary::transform(const cv::Mat& descriptors, BowVector& bow, FeatureVe
   normalize_l1(bow);
 }
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

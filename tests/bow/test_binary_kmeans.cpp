@@ -3,10 +3,10 @@
 #include <set>
 
 #include "crowdslam/feature/descriptor.h"
-#include "crowdslam/loop/binary_kmeans.h"
-#include "loop_test_data.h"
+#include "crowdslam/bow/binary_kmeans.h"
+#include "bow_test_data.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 std::vector<const std::uint8_t*> row_pointers(const cv::Mat& m) {
@@ -77,4 +77,4 @@ TEST(KMeansBinary, DeterministicForASeed) {
 }
 
 }  // namespace
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

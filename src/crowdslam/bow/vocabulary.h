@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "crowdslam/loop/bow_vector.h"
+#include "crowdslam/bow/bow_vector.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 
 inline constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 inline constexpr std::uint32_t kNoWord = 0xFFFFFFFFu;
@@ -113,4 +113,4 @@ class Vocabulary {
   std::vector<NodeId> word_node_;
 };
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

@@ -5,11 +5,11 @@
 #include <memory>
 
 #include "crowdslam/feature/descriptor.h"
-#include "crowdslam/loop/vocabulary.h"
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 namespace {
 
 constexpr char kMagic[8] = {'C', 'S', 'L', 'M', 'V', 'O', 'C', '1'};
@@ -136,4 +136,4 @@ Vocabulary Vocabulary::read(const std::string& path) {
   return has_magic(path) ? load(path) : import_dbow2_text(path);
 }
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow

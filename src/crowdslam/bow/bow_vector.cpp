@@ -1,9 +1,9 @@
-#include "crowdslam/loop/bow_vector.h"
+#include "crowdslam/bow/bow_vector.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace crowdslam::loop {
+namespace crowdslam::bow {
 
 void normalize_l1(BowVector& bow) {
   double sum = 0.0;
@@ -34,4 +34,4 @@ double l1_score(const BowVector& a, const BowVector& b) {
   return std::clamp(1.0 - 0.5 * distance, 0.0, 1.0);
 }
 
-}  // namespace crowdslam::loop
+}  // namespace crowdslam::bow
