@@ -1,5 +1,7 @@
-// Speed of the ORB vocabulary (loop/vocabulary.h).
+// Speed of the ORB vocabulary (bow/vocabulary.h).
 //   bench_vocabulary --benchmark_filter=LoadBinary   target: a 1M-word vocabulary (k = 10, L = 6) < 0.5 s
+//   bench_vocabulary --benchmark_filter=LoadDefault  the default vocabulary (bow/vocabulary_path.h;
+//                                                    scripts/build_vocabulary.sh), target < 0.5 s
 //   bench_vocabulary --benchmark_filter=Transform    1000 descriptors -> BoW + direct index
 //   bench_vocabulary --benchmark_filter=ImportText   DBoW2 text import (k = 10, L = 5, 111k nodes)
 // The 1M-word file is written here in the documented binary format (full tree, random descriptors);
@@ -14,6 +16,7 @@
 #include <string>
 
 #include "crowdslam/bow/vocabulary.h"
+#include "crowdslam/bow/vocabulary_path.h"
 
 namespace {
 
@@ -95,6 +98,22 @@ void BM_LoadBinary(benchmark::State& state) {
   state.counters["words"] = static_cast<double>(words);
 }
 BENCHMARK(BM_LoadBinary)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void BM_LoadDefault(benchmark::State& state) {
+  const std::string path = crowdslam::bow::default_vocabulary_path();
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError(("default vocabulary " + path + " missing (scripts/build_vocabulary.sh)").c_str());
+    return;
+  }
+  std::size_t words = 0;
+  for (auto _ : state) {
+    const Vocabulary voc = Vocabulary::read(path);
+    words = voc.num_words();
+    benchmark::DoNotOptimize(words);
+  }
+  state.counters["words"] = static_cast<double>(words);
+}
+BENCHMARK(BM_LoadDefault)->Unit(benchmark::kMillisecond);
 
 void BM_Transform(benchmark::State& state) {
   static const Vocabulary voc = Vocabulary::load(binary_file());

@@ -36,6 +36,12 @@ if [[ ! -f "$build_dir/build.ninja" ]]; then
 fi
 cmake --build "$build_dir" -j "$jobs"
 
+# Default ORB vocabulary (vocabulary/crowdslam_orb.voc, never committed): trained from opencv-doc's
+# sample images in about 10 s; skipped when present with the recorded SHA-256.
+if ! scripts/build_vocabulary.sh "$build_dir" >/dev/null; then
+  echo "setup: warning: default vocabulary not built (see the error above)" >&2
+fi
+
 # Person-detector models (copied from ../shared or downloaded with a SHA-256 check; never committed).
 # Without them `crowdslam run` needs --no-people-filter or --detections, and detector tests are skipped.
 if ! scripts/install_models.sh >/dev/null; then

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   add_synth_command(app, global);
   add_run_command(app, global);
   add_detect_command(app, global);
+  add_vocab_command(app, global);
 
   try {
     app.parse(argc, argv);

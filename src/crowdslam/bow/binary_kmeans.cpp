@@ -1,6 +1,7 @@
 #include "crowdslam/bow/binary_kmeans.h"
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 
 namespace crowdslam::bow {
@@ -44,11 +45,28 @@ std::vector<Descriptor> seed_plus_plus(const std::vector<const std::uint8_t*>& r
   return centres;
 }
 
-std::size_t nearest_centre(const std::uint8_t* row, const std::vector<Descriptor>& centres) {
+// A descriptor as four 64-bit words (memcpy: no alignment assumption).
+struct Words {
+  std::uint64_t w[feature::kDescriptorBytes / 8];
+};
+
+Words load_words(const std::uint8_t* bytes) {
+  Words words;
+  std::memcpy(words.w, bytes, sizeof words.w);
+  return words;
+}
+
+int distance(const Words& a, const Words& b) {
+  return feature::popcount64(a.w[0] ^ b.w[0]) + feature::popcount64(a.w[1] ^ b.w[1]) +
+         feature::popcount64(a.w[2] ^ b.w[2]) + feature::popcount64(a.w[3] ^ b.w[3]);
+}
+
+std::size_t nearest_centre(const std::uint8_t* row, const std::vector<Words>& centres) {
+  const Words words = load_words(row);
   std::size_t best = 0;
   int best_distance = std::numeric_limits<int>::max();
   for (std::size_t c = 0; c < centres.size(); ++c) {
-    const int d = feature::hamming_distance(row, centres[c].data());
+    const int d = distance(words, centres[c]);
     if (d < best_distance) {
       best_distance = d;
       best = c;
@@ -57,22 +75,45 @@ std::size_t nearest_centre(const std::uint8_t* row, const std::vector<Descriptor
   return best;
 }
 
+// kSpread[b]: byte i (i = 0..7) is bit i of b, so adding spread bytes counts 8 bits at once.
+constexpr std::array<std::uint64_t, 256> make_spread() {
+  std::array<std::uint64_t, 256> table{};
+  for (int b = 0; b < 256; ++b) {
+    for (int bit = 0; bit < 8; ++bit) table[b] |= static_cast<std::uint64_t>((b >> bit) & 1) << (8 * bit);
+  }
+  return table;
+}
+constexpr std::array<std::uint64_t, 256> kSpread = make_spread();
+
 }  // namespace
 
 Descriptor majority_centroid(const std::vector<const std::uint8_t*>& rows,
                              const std::vector<std::size_t>& members) {
-  std::array<int, 8 * feature::kDescriptorBytes> ones{};
+  // Per descriptor byte, eight 8-bit counters packed in one word; they are emptied into `ones` before
+  // any can overflow (at most 255 rows per batch).
+  std::array<std::size_t, 8 * feature::kDescriptorBytes> ones{};
+  std::array<std::uint64_t, feature::kDescriptorBytes> lanes{};
+  auto flush = [&] {
+    for (int byte = 0; byte < feature::kDescriptorBytes; ++byte) {
+      for (int bit = 0; bit < 8; ++bit) ones[8 * byte + bit] += (lanes[byte] >> (8 * bit)) & 0xFF;
+      lanes[byte] = 0;
+    }
+  };
+  std::size_t batch = 0;
   for (std::size_t m : members) {
     const std::uint8_t* row = rows[m];
-    for (int byte = 0; byte < feature::kDescriptorBytes; ++byte) {
-      for (int bit = 0; bit < 8; ++bit) ones[8 * byte + bit] += (row[byte] >> bit) & 1;
+    for (int byte = 0; byte < feature::kDescriptorBytes; ++byte) lanes[byte] += kSpread[row[byte]];
+    if (++batch == 255) {
+      flush();
+      batch = 0;
     }
   }
+  flush();
   Descriptor centre{};
   for (int byte = 0; byte < feature::kDescriptorBytes; ++byte) {
     std::uint8_t value = 0;
     for (int bit = 0; bit < 8; ++bit) {
-      if (2 * static_cast<std::size_t>(ones[8 * byte + bit]) > members.size()) value |= 1u << bit;
+      if (2 * ones[8 * byte + bit] > members.size()) value |= 1u << bit;
     }
     centre[byte] = value;
   }
@@ -86,11 +127,13 @@ BinaryClusters kmeans_binary(const std::vector<const std::uint8_t*>& rows, int k
   std::vector<Descriptor> centres = seed_plus_plus(rows, k, rng);
   std::vector<std::size_t> assignment(rows.size(), centres.size());
   std::vector<std::vector<std::size_t>> members(centres.size());
+  std::vector<Words> centre_words(centres.size());
   for (int iteration = 0; iteration < std::max(1, max_iterations); ++iteration) {
     bool changed = false;
     for (auto& m : members) m.clear();
+    for (std::size_t c = 0; c < centres.size(); ++c) centre_words[c] = load_words(centres[c].data());
     for (std::size_t i = 0; i < rows.size(); ++i) {
-      const std::size_t c = nearest_centre(rows[i], centres);
+      const std::size_t c = nearest_centre(rows[i], centre_words);
       changed = changed || c != assignment[i];
       assignment[i] = c;
       members[c].push_back(i);

@@ -15,7 +15,9 @@
 //                      L u32, node count u64;
 //   then per node (44 bytes): parent u32 (0xFFFFFFFF for the root), descriptor 32 bytes,
 //                      weight f32, word id u32 (0xFFFFFFFF for inner nodes).
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -29,11 +31,22 @@ inline constexpr std::uint32_t kNoWord = 0xFFFFFFFFu;
 // Default direct-index level, counted up from the leaves (ORB-SLAM2 uses 4 with a 6-level tree).
 inline constexpr int kDefaultLevelsUp = 4;
 
+// Where training is: `level` (1..L) is the tree level being built, `descriptors_done` of
+// `descriptors_total` the descriptors whose node at that level has been clustered.
+struct VocabularyTrainProgress {
+  int level = 0;
+  int levels = 0;
+  std::size_t descriptors_done = 0;
+  std::size_t descriptors_total = 0;
+};
+
 struct VocabularyTrainOptions {
   int k = 10;               // branching factor
   int levels = 6;           // depth L (levels below the root)
   std::uint64_t seed = 1;   // k-means++ seeding; same seed and data give the same vocabulary
   int max_iterations = 10;  // Lloyd iterations per k-means
+  // Called on the training thread after each tree node is clustered (or found to be a leaf); may be empty.
+  std::function<void(const VocabularyTrainProgress&)> progress;
   // Throws InputError naming the bad option and its value.
   void check() const;
 };

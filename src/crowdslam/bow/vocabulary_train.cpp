@@ -1,7 +1,6 @@
 // Vocabulary training: hierarchical k-means++ (breadth first, so parents get smaller ids than their
 // children) and IDF weights from the training images.
 #include <cmath>
-#include <deque>
 #include <random>
 #include <utility>
 
@@ -53,34 +52,44 @@ Vocabulary Vocabulary::train(const std::vector<cv::Mat>& descriptors_per_image,
   voc.parent_.push_back(kNoNode);
   voc.descriptors_.assign(feature::kDescriptorBytes, 0);
   voc.weight_.push_back(0.0f);
-  std::vector<int> level{0};
 
+  // Level by level (parents in id order, so this is a breadth-first order): node ids increase with the
+  // level, and one generator drives every k-means in that order.
   std::mt19937_64 rng(options.seed);
-  std::deque<std::pair<NodeId, std::vector<std::size_t>>> queue;
+  std::vector<std::pair<NodeId, std::vector<std::size_t>>> current;
+  std::vector<std::pair<NodeId, std::vector<std::size_t>>> next;
   std::vector<std::size_t> all(rows.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-  queue.emplace_back(0, std::move(all));
+  current.emplace_back(0, std::move(all));
   std::vector<const std::uint8_t*> subset;
-  while (!queue.empty()) {
-    const NodeId node = queue.front().first;
-    const std::vector<std::size_t> members = std::move(queue.front().second);
-    queue.pop_front();
-    if (level[node] >= options.levels || members.size() <= 1) continue;
-    subset.clear();
-    for (std::size_t m : members) subset.push_back(rows[m]);
-    BinaryClusters clusters = kmeans_binary(subset, options.k, options.max_iterations, rng);
-    if (clusters.centres.size() <= 1) continue;  // all members identical: a leaf
-    for (std::size_t c = 0; c < clusters.centres.size(); ++c) {
-      const auto child = static_cast<NodeId>(voc.parent_.size());
-      voc.parent_.push_back(node);
-      voc.descriptors_.insert(voc.descriptors_.end(), clusters.centres[c].begin(), clusters.centres[c].end());
-      voc.weight_.push_back(0.0f);
-      level.push_back(level[node] + 1);
-      std::vector<std::size_t> child_members;
-      child_members.reserve(clusters.members[c].size());
-      for (std::size_t s : clusters.members[c]) child_members.push_back(members[s]);
-      queue.emplace_back(child, std::move(child_members));
+  for (int depth = 0; depth < options.levels && !current.empty(); ++depth) {
+    VocabularyTrainProgress progress{depth + 1, options.levels, 0, 0};
+    for (const auto& node : current) progress.descriptors_total += node.second.size();
+    for (auto& [node, members] : current) {
+      progress.descriptors_done += members.size();
+      if (members.size() > 1) {
+        subset.clear();
+        for (std::size_t m : members) subset.push_back(rows[m]);
+        BinaryClusters clusters = kmeans_binary(subset, options.k, options.max_iterations, rng);
+        if (clusters.centres.size() > 1) {  // else all members are identical: a leaf
+          for (std::size_t c = 0; c < clusters.centres.size(); ++c) {
+            const auto child = static_cast<NodeId>(voc.parent_.size());
+            voc.parent_.push_back(node);
+            voc.descriptors_.insert(voc.descriptors_.end(), clusters.centres[c].begin(),
+                                    clusters.centres[c].end());
+            voc.weight_.push_back(0.0f);
+            std::vector<std::size_t> child_members;
+            child_members.reserve(clusters.members[c].size());
+            for (std::size_t s : clusters.members[c]) child_members.push_back(members[s]);
+            next.emplace_back(child, std::move(child_members));
+          }
+        }
+      }
+      std::vector<std::size_t>().swap(members);
+      if (options.progress) options.progress(progress);
     }
+    current.swap(next);
+    next.clear();
   }
   voc.finish("vocabulary training", true);
   const std::vector<float> weights = idf_weights(voc, descriptors_per_image);

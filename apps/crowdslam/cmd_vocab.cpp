@@ -1,0 +1,342 @@
+// `crowdslam vocab train`: trains an ORB vocabulary tree from images, videos and datasets.
+// `crowdslam vocab info`: size and load time of a vocabulary (our binary format or DBoW2 text).
+// `crowdslam vocab convert`: DBoW2 / ORB-SLAM2 text vocabulary (ORBvoc.txt) -> our binary format.
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "crowdslam/bow/vocabulary.h"
+#include "crowdslam/bow/vocabulary_path.h"
+#include "crowdslam/feature/orb_extractor.h"
+#include "crowdslam/io/dataset.h"
+#include "crowdslam/io/image_check.h"
+#include "crowdslam/io/image_folder_dataset.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::app {
+namespace {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Progress on stderr: one rewritten line on a terminal (at most 10 updates a second), otherwise
+// spdlog info lines at milestones only. Only warnings with --quiet or --json (stdout stays pure JSON).
+class Progress {
+ public:
+  explicit Progress(const GlobalOptions& global)
+      : json_(global.json),
+        tty_(!global.quiet && !global.json && ::isatty(STDERR_FILENO) == 1),
+        log_(!global.quiet && !global.json && !tty_) {}
+  ~Progress() { end_line(); }
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  // A transient status (terminal only).
+  void status(const std::string& text, bool force = false) {
+    if (!tty_) return;
+    const auto now = Clock::now();
+    if (!force && open_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    std::fprintf(stderr, "\r%-*s", static_cast<int>(std::max<std::size_t>(width_, text.size())),
+                 text.c_str());
+    std::fflush(stderr);
+    width_ = text.size();
+    open_ = true;
+  }
+  // A milestone: the final status line on a terminal, a log line otherwise.
+  void milestone(const std::string& text) {
+    if (tty_) {
+      status(text, true);
+      end_line();
+    } else if (log_) {
+      spdlog::info("{}", text);
+    }
+  }
+  // A warning: always shown, on stderr (spdlog writes to stdout, which --json keeps for the document).
+  void warn(const std::string& text) {
+    end_line();
+    if (json_) {
+      std::fprintf(stderr, "[warning] %s\n", text.c_str());
+    } else {
+      spdlog::warn("{}", text);
+    }
+  }
+  void end_line() {
+    if (!open_) return;
+    std::fputc('\n', stderr);
+    std::fflush(stderr);
+    open_ = false;
+    width_ = 0;
+  }
+
+ private:
+  bool json_;
+  bool tty_;
+  bool log_;
+  bool open_ = false;
+  std::size_t width_ = 0;
+  Clock::time_point last_{};
+};
+
+struct TrainArgs {
+  std::vector<std::string> inputs;
+  std::string out;
+  bow::VocabularyTrainOptions options;
+  int features = 1000;
+  std::size_t max_images = 0;
+  std::size_t every = 1;
+  bool force = false;
+};
+
+struct Collected {
+  std::vector<cv::Mat> descriptors;  // one per image with descriptors
+  std::size_t images = 0;
+  std::size_t rows = 0;
+};
+
+// Collects ORB descriptors image by image, input by input, until `max_images` are in.
+class DescriptorCollector {
+ public:
+  DescriptorCollector(const TrainArgs& args, Progress& progress) : args_(args), progress_(progress) {
+    feature::ORBExtractor::Options orb;  // the defaults of config/TUM1.yaml: 1000, 1.2, 8, 20/7
+    orb.num_features = args.features;
+    orb.check();
+    extractor_ = std::make_unique<feature::ORBExtractor>(orb);
+  }
+
+  bool full() const { return args_.max_images > 0 && result_.images >= args_.max_images; }
+
+  void add(const cv::Mat& image, const std::string& source) {
+    std::vector<cv::KeyPoint> keypoints;
+    cv::Mat descriptors;
+    extractor_->extract(feature::to_gray(image), keypoints, descriptors);
+    ++result_.images;
+    if (descriptors.rows > 0) {
+      result_.rows += static_cast<std::size_t>(descriptors.rows);
+      result_.descriptors.push_back(descriptors);
+    }
+    progress_.status("reading: " + std::to_string(result_.images) + " images, " +
+                     std::to_string(result_.rows) + " descriptors (" + source + ")");
+  }
+
+  // Every image of one input (an image file, a folder, a dataset or a video).
+  void add_input(const std::string& input) {
+    const std::size_t images_before = result_.images;
+    const std::size_t rows_before = result_.rows;
+    std::error_code ec;
+    if (fs::is_regular_file(input, ec) && io::is_image_file_name(input)) {
+      if (!full()) add(io::read_colour_image(input), input);
+    } else {
+      const auto source = io::open_source(input);
+      std::size_t index = 0;
+      while (!full()) {
+        const auto frame = source->next();
+        if (!frame) break;
+        if (index++ % args_.every == 0) add(frame->images.colour, input);
+      }
+    }
+    const std::size_t images = result_.images - images_before;
+    const std::size_t rows = result_.rows - rows_before;
+    if (images > 0 && rows == 0)
+      progress_.warn(input + ": no ORB features in " + std::to_string(images) + " image(s)");
+    progress_.milestone("read " + input + ": " + std::to_string(images) + " images, " + std::to_string(rows) +
+                        " descriptors");
+  }
+
+  Collected take() { return std::move(result_); }
+
+ private:
+  const TrainArgs& args_;
+  Progress& progress_;
+  std::unique_ptr<feature::ORBExtractor> extractor_;
+  Collected result_;
+};
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+void check_train_args(const TrainArgs& args) {
+  const bow::VocabularyTrainOptions& o = args.options;
+  if (o.k < 2) throw InputError("--k must be at least 2, got " + std::to_string(o.k));
+  if (o.levels < 1 || o.levels > 255)
+    throw InputError("--levels must be in [1, 255], got " + std::to_string(o.levels));
+  o.check();
+  if (args.features < 1)
+    throw InputError("--features must be at least 1, got " + std::to_string(args.features));
+  if (args.every < 1) throw InputError("--every must be at least 1");
+  std::error_code ec;
+  if (fs::exists(args.out, ec) && !args.force)
+    throw input_error(args.out, "output exists (use --force to replace it)");
+  if (fs::is_directory(args.out, ec)) throw input_error(args.out, "output is a directory");
+  // Every input must exist before any work starts (a bare number would open a camera otherwise).
+  for (const std::string& input : args.inputs) {
+    if (!fs::exists(input, ec)) throw input_error(input, "no such file or directory");
+  }
+}
+
+void run_train(TrainArgs& args, const GlobalOptions& global) {
+  check_train_args(args);
+  Progress progress(global);
+  const auto start = Clock::now();
+  DescriptorCollector collector(args, progress);
+  for (const std::string& input : args.inputs) {
+    if (collector.full()) break;
+    collector.add_input(input);
+  }
+  const Collected data = collector.take();
+  const double read_s = seconds_since(start);
+  if (data.rows == 0) {
+    throw input_error(join(args.inputs), "no ORB descriptors in " + std::to_string(data.images) +
+                                             " image(s): nothing to train a vocabulary on");
+  }
+  progress.milestone("read " + std::to_string(data.images) + " images, " + std::to_string(data.rows) +
+                     " descriptors in " + fmt::format("{:.1f}", read_s) + " s");
+
+  int last_level = 0;
+  args.options.progress = [&](const bow::VocabularyTrainProgress& p) {
+    const int percent =
+        static_cast<int>(100 * p.descriptors_done / std::max<std::size_t>(p.descriptors_total, 1));
+    progress.status(fmt::format("k-means: level {}/{}, {}%", p.level, p.levels, percent),
+                    p.level != last_level);
+    last_level = p.level;
+    if (p.descriptors_done == p.descriptors_total)
+      progress.milestone(fmt::format("k-means: level {}/{} done after {:.1f} s", p.level, p.levels,
+                                     seconds_since(start) - read_s));
+  };
+  const auto train_start = Clock::now();
+  const bow::Vocabulary voc = bow::Vocabulary::train(data.descriptors, args.options);
+  const double train_s = seconds_since(train_start);
+  voc.save(args.out);  // atomic: a failure leaves no file
+  if (global.json) {
+    print_json({{"out", args.out},
+                {"inputs", args.inputs},
+                {"images", data.images},
+                {"descriptors", data.rows},
+                {"k", voc.k()},
+                {"levels", voc.levels()},
+                {"depth", voc.depth()},
+                {"nodes", voc.num_nodes()},
+                {"words", voc.num_words()},
+                {"seed", args.options.seed},
+                {"read_s", read_s},
+                {"train_s", train_s}});
+    return;
+  }
+  std::printf("images       %zu\n", data.images);
+  std::printf("descriptors  %zu\n", data.rows);
+  std::printf("tree         k %d, L %d, depth %d, %zu nodes, %zu words\n", voc.k(), voc.levels(), voc.depth(),
+              voc.num_nodes(), voc.num_words());
+  std::printf("time_s       read %.1f, train %.1f\n", read_s, train_s);
+  std::printf("written      %s\n", args.out.c_str());
+  std::fflush(stdout);
+}
+
+void run_info(const std::string& path, const GlobalOptions& global) {
+  const auto start = Clock::now();
+  const bow::Vocabulary voc = bow::Vocabulary::read(path);
+  const double load_ms = 1e3 * seconds_since(start);
+  std::error_code ec;
+  const auto bytes = fs::file_size(path, ec);
+  if (global.json) {
+    print_json({{"path", path},
+                {"bytes", ec ? 0 : bytes},
+                {"k", voc.k()},
+                {"levels", voc.levels()},
+                {"depth", voc.depth()},
+                {"nodes", voc.num_nodes()},
+                {"words", voc.num_words()},
+                {"load_ms", load_ms}});
+    return;
+  }
+  std::printf("file     %s (%.1f MB)\n", path.c_str(), ec ? 0.0 : static_cast<double>(bytes) / 1e6);
+  std::printf("k        %d\n", voc.k());
+  std::printf("L        %d\n", voc.levels());
+  std::printf("depth    %d\n", voc.depth());
+  std::printf("nodes    %zu\n", voc.num_nodes());
+  std::printf("words    %zu\n", voc.num_words());
+  std::printf("load_ms  %.1f\n", load_ms);
+  std::fflush(stdout);
+}
+
+void run_convert(const std::string& in, const std::string& out, bool force, const GlobalOptions& global) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && !force) throw input_error(out, "output exists (use --force to replace it)");
+  const auto start = Clock::now();
+  const bow::Vocabulary voc = bow::Vocabulary::read(in);
+  voc.save(out);
+  const double seconds = seconds_since(start);
+  if (global.json) {
+    print_json({{"in", in},
+                {"out", out},
+                {"nodes", voc.num_nodes()},
+                {"words", voc.num_words()},
+                {"seconds", seconds}});
+    return;
+  }
+  std::printf("converted %s -> %s (%zu nodes, %zu words, %.1f s)\n", in.c_str(), out.c_str(), voc.num_nodes(),
+              voc.num_words(), seconds);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+void add_vocab_command(CLI::App& app, const GlobalOptions& global) {
+  CLI::App* vocab = app.add_subcommand("vocab", "ORB vocabulary tree: train, info, convert");
+  vocab->require_subcommand(1);
+
+  auto train_args = std::make_shared<TrainArgs>();
+  train_args->options.levels = 5;
+  CLI::App* train = vocab->add_subcommand(
+      "train", "Train a vocabulary from image files, image folders, videos and datasets (our ORB)");
+  train->add_option("--out", train_args->out, "Output vocabulary (binary, written atomically)")->required();
+  train->add_option("--k", train_args->options.k, "Branching factor")->capture_default_str();
+  train->add_option("--levels", train_args->options.levels, "Depth L of the tree")->capture_default_str();
+  train->add_option("--seed", train_args->options.seed, "k-means++ seed (same inputs and seed: same bytes)")
+      ->capture_default_str();
+  train->add_option("--features", train_args->features, "ORB features per image")->capture_default_str();
+  train->add_option("--max-images", train_args->max_images, "Stop reading after this many images (0 = all)")
+      ->capture_default_str();
+  train->add_option("--every", train_args->every, "Use every Nth frame of videos, folders and datasets")
+      ->capture_default_str();
+  train->add_flag("--force", train_args->force, "Replace an existing output file");
+  train->add_option("inputs", train_args->inputs, "Image files, image folders, videos, datasets")->required();
+  train->callback([train_args, &global] { run_train(*train_args, global); });
+
+  auto info_path = std::make_shared<std::string>();
+  CLI::App* info = vocab->add_subcommand("info", "k, L, depth, nodes, words and load time of a vocabulary");
+  info->add_option("file", *info_path, "Vocabulary (binary or DBoW2 text; default: the default vocabulary)");
+  info->callback([info_path, &global] {
+    run_info(info_path->empty() ? bow::default_vocabulary_path() : *info_path, global);
+  });
+
+  struct ConvertArgs {
+    std::string in;
+    std::string out;
+    bool force = false;
+  };
+  auto convert_args = std::make_shared<ConvertArgs>();
+  CLI::App* convert =
+      vocab->add_subcommand("convert", "DBoW2 / ORB-SLAM2 text vocabulary (ORBvoc.txt) -> our binary format");
+  convert->add_option("in", convert_args->in, "Input vocabulary (DBoW2 text or binary)")->required();
+  convert->add_option("out", convert_args->out, "Output binary vocabulary (written atomically)")->required();
+  convert->add_flag("--force", convert_args->force, "Replace an existing output file");
+  convert->callback([convert_args, &global] {
+    run_convert(convert_args->in, convert_args->out, convert_args->force, global);
+  });
+}
+
+}  // namespace crowdslam::app
