@@ -9,6 +9,9 @@
 
 namespace crowdslam::geometry {
 
+// Tangent vector of Sim3: (rho, phi, sigma) = translation part, rotation vector, log of the scale.
+using Vec7 = Eigen::Matrix<double, 7, 1>;
+
 class Sim3 {
  public:
   Sim3() : rotation_(Eigen::Quaterniond::Identity()), translation_(Vec3::Zero()) {}
@@ -19,6 +22,11 @@ class Sim3 {
   explicit Sim3(const SE3& rigid) : Sim3(rigid.rotation(), rigid.translation(), 1.0) {}
 
   static Sim3 identity() { return Sim3(); }
+  // Exponential map of sim(3): R = Exp(phi), s = e^sigma, t = W(phi, sigma) rho with
+  // W = integral_0^1 e^(sigma u) Exp(u phi) du. With sigma = 0 it equals SE3::exp((rho, phi)).
+  static Sim3 exp(const Vec7& tangent);
+  // Inverse of exp (rotation angle in [0, pi]).
+  [[nodiscard]] Vec7 log() const;
 
   [[nodiscard]] const Eigen::Quaterniond& rotation() const { return rotation_; }
   [[nodiscard]] Mat3 rotation_matrix() const { return rotation_.toRotationMatrix(); }
