@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "crowdslam/loop/keyframe_database.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/util/error.h"
@@ -30,8 +31,14 @@ void LocalMapper::start() {
   {
     std::lock_guard lock(queue_mutex_);
     stop_requested_ = false;
+    worker_active_ = true;
   }
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this] {
+    run();
+    std::lock_guard lock(queue_mutex_);
+    worker_active_ = false;
+    paused_cv_.notify_all();
+  });
 }
 
 void LocalMapper::stop() {
@@ -49,7 +56,14 @@ void LocalMapper::run() {
     {
       std::unique_lock lock(queue_mutex_);
       accepting_ = true;
-      queue_cv_.wait(lock, [this] { return stop_requested_ || !queue_.empty(); });
+      queue_cv_.wait(lock, [this] { return stop_requested_ || !queue_.empty() || pause_requested_; });
+      if (pause_requested_) {  // loop correction or global BA: wait here until resumed
+        paused_ = true;
+        paused_cv_.notify_all();
+        queue_cv_.wait(lock, [this] { return !pause_requested_; });
+        paused_ = false;
+        continue;
+      }
       if (queue_.empty()) return;  // stop requested and nothing left to do
       accepting_ = false;
       keyframe = queue_.front();
@@ -69,6 +83,30 @@ std::shared_ptr<map::KeyFrame> LocalMapper::next_keyframe() {
   auto keyframe = queue_.front();
   queue_.pop_front();
   return keyframe;
+}
+
+void LocalMapper::request_pause() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    pause_requested_ = true;
+    abort_ba_ = true;
+  }
+  queue_cv_.notify_all();
+}
+
+void LocalMapper::wait_until_paused() {
+  std::unique_lock lock(queue_mutex_);
+  // Sequential mode (no worker): the mapper runs inline on the caller's thread, so it is idle now.
+  paused_cv_.wait(lock, [this] { return paused_ || !pause_requested_ || !worker_active_; });
+}
+
+void LocalMapper::resume() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    pause_requested_ = false;
+  }
+  queue_cv_.notify_all();
+  paused_cv_.notify_all();
 }
 
 void LocalMapper::insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe) {
@@ -121,13 +159,16 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
   const double fusion_ms = ms_since(t);
   abort_ba_ = false;
   double culling_ms = 0;
-  if (!has_new_keyframes()) {
+  if (!has_new_keyframes() && !pause_requested_) {
     if (options_.local_ba && map_->num_keyframes() > 2) run_local_bundle_adjustment(keyframe);
     t = Clock::now();
     cull_keyframes(keyframe);
     culling_ms = ms_since(t);
   }
   map_->erase_bad_map_points();
+  // Place recognition sees the keyframe only once it is registered in the map.
+  if (database_ && keyframe->features->has_bow() && !keyframe->is_bad()) database_->add(keyframe);
+  if (keyframe_done_ && !keyframe->is_bad()) keyframe_done_(keyframe);
   std::lock_guard lock(stats_mutex_);
   ++stats_.keyframes_processed;
   stats_.register_ms_total += register_ms;

@@ -9,15 +9,21 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "crowdslam/loop/local_mapping_control.h"
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map.h"
 #include "crowdslam/optim/bundle_adjustment.h"
 #include "crowdslam/tracking/keyframe_consumer.h"
+
+namespace crowdslam::loop {
+class KeyframeDatabase;
+}
 
 namespace crowdslam::mapping {
 
@@ -47,7 +53,7 @@ struct LocalMapperStats {
   double processing_ms_total = 0;
 };
 
-class LocalMapper : public tracking::KeyframeConsumer {
+class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMappingControl {
  public:
   LocalMapper(const LocalMapperOptions& options, std::shared_ptr<map::Map> map);
   ~LocalMapper() override;
@@ -67,7 +73,22 @@ class LocalMapper : public tracking::KeyframeConsumer {
   [[nodiscard]] bool accepts_keyframes() const override;
   [[nodiscard]] size_t queued_keyframes() const override;
   void interrupt_bundle_adjustment() override;
-  [[nodiscard]] bool is_paused() const override { return false; }
+  [[nodiscard]] bool is_paused() const override { return pause_requested_; }
+
+  // LocalMappingControl (loop closing): pause after the current keyframe, wait, resume.
+  void request_pause() override;
+  void wait_until_paused() override;
+  void resume() override;
+
+  // Called (on the mapping thread) with every keyframe that survived processing: the hand-over to loop
+  // closing.
+  void set_keyframe_done(std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done) {
+    keyframe_done_ = std::move(keyframe_done);
+  }
+
+  // Keyframes that have a bag of words are added to `database` once processed (optional; not owned). Set
+  // before start().
+  void set_keyframe_database(loop::KeyframeDatabase* database) { database_ = database; }
 
   // Drops queued keyframes and recent points (after a map reset). Call with the worker idle or stopped.
   void reset();
@@ -87,11 +108,17 @@ class LocalMapper : public tracking::KeyframeConsumer {
 
   LocalMapperOptions options_;
   std::shared_ptr<map::Map> map_;
+  loop::KeyframeDatabase* database_ = nullptr;
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<std::shared_ptr<map::KeyFrame>> queue_;
   bool stop_requested_ = false;
+  std::atomic<bool> pause_requested_{false};
+  bool paused_ = false;         // the worker is waiting in a pause (queue_mutex_)
+  bool worker_active_ = false;  // the worker thread is running (queue_mutex_)
+  std::condition_variable paused_cv_;
+  std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done_;
   std::atomic<bool> accepting_{true};
   std::atomic<bool> abort_ba_{false};
   std::thread worker_;

@@ -1,0 +1,62 @@
+#pragma once
+// Global bundle adjustment after a loop correction (ORB-SLAM2's RunGlobalBundleAdjustment, our way).
+//
+// All keyframes and map points of the map are copied into plain BA structures and optimised (Ceres,
+// optim::local_bundle_adjustment with every keyframe free except the first) without any lock held. The
+// result is then applied with local mapping paused and under the map-update lock: keyframes created
+// meanwhile are moved with their spanning-tree parent (their pose relative to it is kept), and points
+// created meanwhile are moved with their reference keyframe.
+//
+// Threaded: launch() runs it in its own thread; a new loop calls abort() (the optimisation stops after its
+// current iteration and nothing is applied) before correcting. Inline: run() on the caller's thread.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "crowdslam/loop/local_mapping_control.h"
+#include "crowdslam/map/map.h"
+#include "crowdslam/optim/bundle_adjustment.h"
+
+namespace crowdslam::loop {
+
+struct GlobalBaStats {
+  int runs = 0;
+  int aborted = 0;
+  int applied = 0;
+  double time_ms_total = 0;
+};
+
+class GlobalBundleAdjuster {
+ public:
+  GlobalBundleAdjuster(std::shared_ptr<map::Map> map, LocalMappingControl* mapper, int iterations = 10);
+  ~GlobalBundleAdjuster();
+  GlobalBundleAdjuster(const GlobalBundleAdjuster&) = delete;
+  GlobalBundleAdjuster& operator=(const GlobalBundleAdjuster&) = delete;
+
+  // Aborts a running adjustment, then starts a new one in its own thread.
+  void launch();
+  // Runs one adjustment on the caller's thread (sequential mode). Returns true when it was applied.
+  bool run();
+  // Stops a running adjustment (nothing of it is applied) and joins its thread. Idempotent.
+  void abort();
+  // Waits for a running adjustment to finish (and be applied).
+  void wait();
+  [[nodiscard]] bool is_running() const { return running_; }
+  [[nodiscard]] GlobalBaStats stats() const;
+
+ private:
+  bool optimise_and_apply();
+
+  std::shared_ptr<map::Map> map_;
+  LocalMappingControl* mapper_;
+  int iterations_;
+  std::atomic<bool> abort_{false};
+  std::atomic<bool> running_{false};
+  std::thread worker_;
+  mutable std::mutex stats_mutex_;
+  GlobalBaStats stats_;
+};
+
+}  // namespace crowdslam::loop
