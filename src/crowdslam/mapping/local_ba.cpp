@@ -1,4 +1,5 @@
 // Local mapping step: local bundle adjustment over the new keyframe's covisibility neighbourhood.
+#include <algorithm>
 #include <chrono>
 #include <unordered_map>
 #include <unordered_set>
@@ -14,7 +15,7 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
   // those points.
   std::vector<std::shared_ptr<map::KeyFrame>> local{keyframe};
   std::unordered_set<uint64_t> local_ids{keyframe->id};
-  for (const auto& kf : keyframe->connected_keyframes()) {
+  for (const auto& kf : keyframe->best_covisible(static_cast<size_t>(options_.max_local_ba_keyframes))) {
     if (!kf->is_bad() && local_ids.insert(kf->id).second) local.push_back(kf);
   }
   std::vector<std::shared_ptr<map::MapPoint>> points;
@@ -26,6 +27,23 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
   }
   std::unordered_map<uint64_t, std::shared_ptr<map::KeyFrame>> all_keyframes;
   for (const auto& kf : local) all_keyframes[kf->id] = kf;
+  // Fixed keyframes: those outside the window that see the most of its points, at most
+  // max_local_ba_keyframes of them (observations from the others are left out).
+  std::unordered_set<uint64_t> fixed_ids;
+  {
+    std::unordered_map<uint64_t, int> seen_points;
+    for (const auto& point : points) {
+      for (const auto& [kf_id, obs] : point->observations()) {
+        if (!local_ids.count(kf_id)) ++seen_points[kf_id];
+      }
+    }
+    std::vector<std::pair<int, uint64_t>> by_count;
+    for (const auto& [kf_id, count] : seen_points) by_count.emplace_back(count, kf_id);
+    const size_t keep = std::min(by_count.size(), static_cast<size_t>(options_.max_local_ba_keyframes));
+    std::partial_sort(by_count.begin(), by_count.begin() + static_cast<std::ptrdiff_t>(keep), by_count.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+    for (size_t i = 0; i < keep; ++i) fixed_ids.insert(by_count[i].second);
+  }
 
   std::vector<optim::BaObservation> observations;
   struct Link {
@@ -40,6 +58,7 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
     const auto& point = points[k];
     ba_points.push_back({static_cast<int>(k), point->world()});
     for (const auto& [kf_id, obs] : point->observations()) {
+      if (!local_ids.count(kf_id) && !fixed_ids.count(kf_id)) continue;
       auto kf = obs.keyframe.lock();
       if (!kf || kf->is_bad()) continue;
       all_keyframes.emplace(kf_id, kf);  // fixed if not local

@@ -14,6 +14,7 @@ namespace crowdslam::mapping {
 
 void LocalMapperOptions::check() const {
   if (!(close_depth_m > 0)) throw InputError("local mapper: close depth must be > 0");
+  if (max_local_ba_keyframes < 1) throw InputError("local mapper: max_local_ba_keyframes must be >= 1");
   if (triangulation_neighbours < 1) throw InputError("local mapper: triangulation_neighbours must be >= 1");
   if (!(redundancy_ratio > 0 && redundancy_ratio <= 1)) throw InputError("local mapper: redundancy_ratio in (0, 1]");
   ba.check();

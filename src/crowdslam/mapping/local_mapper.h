@@ -33,6 +33,10 @@ struct LocalMapperOptions {
   int triangulation_neighbours = 10;  // 20 for monocular
   double redundancy_ratio = 0.9;      // keyframe culling: fraction of points seen by 3+ other keyframes
   bool local_ba = true;
+  // Local BA window: the new keyframe and at most this many of its best covisible keyframes, plus at most
+  // this many fixed keyframes (those that see most of the window's points). ORB-SLAM2 takes all of them;
+  // after a loop merges two passes over a place that becomes hundreds (see docs/ARCHITECTURE.md).
+  int max_local_ba_keyframes = 25;
   optim::BundleAdjustmentOptions ba;
   void check() const;
 };
