@@ -24,7 +24,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
       ->required();
   cmd->add_option("--settings,-s", args->options.settings_path, "Settings YAML (default: DATASET/settings.yaml)");
   cmd->add_option("--out,-o", args->options.out_dir, "Output directory")->required();
-  cmd->add_option("--sensor", args->sensor, "Override the sensor: rgbd (mono and stereo: not yet)");
+  cmd->add_option("--sensor", args->sensor, "Override the sensor detected from the dataset: rgbd, stereo or mono (mono: the colour / left images only)");
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
   cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)");
@@ -36,6 +36,11 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--filter-mode", args->options.filter_mode, "People filter mode: paper or depth");
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
+  cmd->add_option("--vocabulary", args->options.vocabulary,
+                  "ORB vocabulary for relocalisation (default: $CROWDSLAM_VOCABULARY or vocabulary/crowdslam_orb.voc); "
+                  "'none' relocalises by brute-force matching");
+  cmd->add_flag("!--no-loop-closing", args->options.loop_closing,
+                "Run without the loop closing thread (no place recognition, no pose-graph or global BA)");
   cmd->callback([args, &global] {
     if (!args->sensor.empty()) args->options.sensor = io::parse_sensor_kind(args->sensor, "--sensor");
     args->options.max_frames = args->frames;
@@ -53,7 +58,12 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
               << "tracking ms       median " << summary.tracking_ms_median << ", p95 " << summary.tracking_ms_p95
               << "\n"
               << "extraction ms     median " << summary.extraction_ms_median << "\n";
+    if (summary.init_frame) std::cout << "initialised at    frame " << *summary.init_frame << "\n";
     if (summary.ate_rmse_m) std::cout << "ATE RMSE          " << *summary.ate_rmse_m << " m\n";
+    const auto& accuracy = summary.json["accuracy"];
+    if (accuracy.is_object() && accuracy.contains("sim3_scale")) {
+      std::cout << "ATE alignment     sim3 (scale " << accuracy["sim3_scale"].get<double>() << ")\n";
+    }
     if (summary.rpe_trans_rmse_m) std::cout << "RPE trans RMSE    " << *summary.rpe_trans_rmse_m << " m/s\n";
     std::cout << "outputs           " << args->options.out_dir << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json}\n";
   });

@@ -38,9 +38,10 @@ TEST(CliRun, UnsupportedSensorAndBadSettingsAreClearErrors) {
   TempDir dir;
   const auto seq = small_sequence(dir);
   const auto out = dir / "out";
-  const auto mono = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sensor", "mono"});
-  EXPECT_NE(mono.exit_code, 0);
-  EXPECT_NE(mono.err.find("monocular"), std::string::npos) << mono.err;
+  const auto unknown = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sensor", "lidar"});
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.err.find("--sensor"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("lidar"), std::string::npos) << unknown.err;
 
   // A settings file with a bad value names the file and the key.
   std::ifstream in(seq / "settings.yaml");

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +12,7 @@
 
 #include "crowdslam/eval/ate.h"
 #include "crowdslam/eval/rpe.h"
+#include "crowdslam/io/euroc_dataset.h"
 #include "crowdslam/io/settings.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/system/frame_prefetcher.h"
@@ -64,6 +66,9 @@ nlohmann::json frame_json(const FrameReport& r) {
           {"keypoints_before_filter", r.keypoints_before_filter},
           {"detector_ms", r.detector_ms},
           {"detector_wait_ms", r.detector_wait_ms},
+          {"stereo_matches", r.stereo_matches},
+          {"right_wait_ms", r.right_wait_ms},
+          {"stereo_match_ms", r.stereo_match_ms},
           {"timestamp", r.timestamp_s},
           {"extraction_ms", r.extraction_ms},
           {"tracking_ms", r.tracking_ms},
@@ -76,6 +81,27 @@ nlohmann::json frame_json(const FrameReport& r) {
           {"keyframe", r.new_keyframe}};
 }
 
+// Stereo: raw EuRoC pairs without LEFT/RIGHT blocks are rectified from the dataset's sensor.yaml
+// calibration; otherwise the images must already be rectified (no distortion).
+void prepare_stereo_settings(const io::FrameSource& source, io::Settings& settings) {
+  if (settings.rectification) return;
+  if (const auto* euroc = dynamic_cast<const io::EurocDataset*>(&source)) {
+    const auto right = euroc->right_calibration();
+    const auto right_from_left = euroc->right_from_left();
+    assert(right && right_from_left);  // a stereo EuRoC dataset has cam1
+    const std::string where = source.path() + " (cam0/cam1 sensor.yaml)";
+    apply_rectification(settings, rectification_from_euroc(euroc->left_calibration(), *right, *right_from_left, where));
+    spdlog::info("stereo rectification computed from {}: fx {:.3f}, bf {:.4f}", where, settings.camera.fx,
+                 settings.camera.bf);
+    return;
+  }
+  const auto& c = settings.camera;
+  if (c.k1 != 0 || c.k2 != 0 || c.p1 != 0 || c.p2 != 0 || c.k3 != 0) {
+    throw input_error(settings.path, "Camera.k1/k2/p1/p2/k3: stereo images must be rectified, but the camera has "
+                                     "distortion and the settings have no LEFT/RIGHT rectification blocks");
+  }
+}
+
 }  // namespace
 
 RunSummary run_sequence(const RunOptions& options) {
@@ -84,9 +110,9 @@ RunSummary run_sequence(const RunOptions& options) {
   if (sensor == io::SensorKind::kRgbd && source->sensor() != io::SensorKind::kRgbd) {
     throw InputError(options.dataset + ": --sensor rgbd needs a dataset with depth images");
   }
-  if (sensor != io::SensorKind::kRgbd) {
-    throw InputError(options.dataset + ": sensor '" + io::to_string(sensor) +
-                     "' is not supported yet (RGB-D only in this version)");
+  if (sensor == io::SensorKind::kStereo && source->sensor() != io::SensorKind::kStereo) {
+    throw InputError(options.dataset + ": --sensor stereo needs a stereo dataset (EuRoC with cam1, KITTI with "
+                     "image_1); this one is " + io::to_string(source->sensor()));
   }
   std::string settings_path = options.settings_path;
   if (settings_path.empty()) settings_path = source->default_settings_path();
@@ -101,6 +127,7 @@ RunSummary run_sequence(const RunOptions& options) {
     run_settings.people_filter.mode = options.filter_mode;
     run_settings.check(sensor);
   }
+  if (sensor == io::SensorKind::kStereo) prepare_stereo_settings(*source, run_settings);
   SystemOptions system_options;
   system_options.sensor = sensor;
   system_options.sequential = options.sequential;
@@ -108,6 +135,8 @@ RunSummary run_sequence(const RunOptions& options) {
   system_options.detections_file = options.detections_file;
   system_options.detector_model = options.detector_model;
   system_options.record_keypoints = options.save_frames > 0;
+  system_options.vocabulary_path = options.vocabulary;
+  system_options.loop_closing = options.loop_closing;
   System slam(run_settings, system_options);
   std::vector<std::pair<size_t, std::vector<uchar>>> saved_frames;  // encoded JPEGs, written at the end
 
@@ -144,6 +173,7 @@ RunSummary run_sequence(const RunOptions& options) {
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& r : reports) {
     if (r.state == tracking::TrackingState::kOk) ++summary.tracked;
+    if (!summary.init_frame && r.method == "init") summary.init_frame = r.index;
     tracking_ms.push_back(r.tracking_ms);
     extraction_ms.push_back(r.extraction_ms);
     total_ms.push_back(r.extraction_ms + r.detector_wait_ms + r.tracking_ms);
@@ -152,6 +182,11 @@ RunSummary run_sequence(const RunOptions& options) {
     frames.push_back(frame_json(r));
   }
   summary.tracked_percent = 100.0 * static_cast<double>(summary.tracked) / static_cast<double>(summary.frames);
+  if (sensor == io::SensorKind::kMonocular && !summary.init_frame) {
+    spdlog::warn("{}: monocular map never initialised in {} frames (needs a textured scene and a camera that "
+                 "translates, not only rotates)",
+                 options.dataset, summary.frames);
+  }
   summary.throughput_fps = static_cast<double>(summary.frames) / wall_s;
   summary.tracking_ms_median = percentile(tracking_ms, 0.5);
   summary.tracking_ms_p95 = percentile(tracking_ms, 0.95);
@@ -167,7 +202,11 @@ RunSummary run_sequence(const RunOptions& options) {
   const io::Trajectory& ground_truth = source->ground_truth();
   if (!ground_truth.empty() && camera_trajectory.size() >= 3) {
     try {
-      const auto ate = eval::evaluate_ate(ground_truth, camera_trajectory, eval::AteOptions{}, "ground truth",
+      // Monocular trajectories have an arbitrary scale: Sim3 alignment, and RPE at the aligned scale.
+      const bool monocular = sensor == io::SensorKind::kMonocular;
+      eval::AteOptions ate_options;
+      ate_options.alignment = monocular ? eval::Alignment::kSim3 : eval::Alignment::kSe3;
+      const auto ate = eval::evaluate_ate(ground_truth, camera_trajectory, ate_options, "ground truth",
                                           "camera trajectory");
       summary.ate_rmse_m = ate.translation_error_m.rmse;
       accuracy = {{"ate_rmse_m", ate.translation_error_m.rmse},
@@ -175,8 +214,11 @@ RunSummary run_sequence(const RunOptions& options) {
                   {"ate_median_m", ate.translation_error_m.median},
                   {"ate_max_m", ate.translation_error_m.max},
                   {"ate_pairs", ate.matches.size()},
-                  {"alignment", "se3"}};
-      const auto rpe = eval::evaluate_rpe(ground_truth, camera_trajectory, eval::RpeOptions{}, "ground truth",
+                  {"alignment", eval::to_string(ate_options.alignment)}};
+      if (monocular) accuracy["sim3_scale"] = ate.alignment.scale;
+      eval::RpeOptions rpe_options;
+      if (monocular) rpe_options.scale = ate.alignment.scale;
+      const auto rpe = eval::evaluate_rpe(ground_truth, camera_trajectory, rpe_options, "ground truth",
                                           "camera trajectory");
       summary.rpe_trans_rmse_m = rpe.translation_error_m.rmse;
       accuracy["rpe_trans_rmse_m_per_s"] = rpe.translation_error_m.rmse;
@@ -191,6 +233,11 @@ RunSummary run_sequence(const RunOptions& options) {
   doc["settings"] = settings_path;
   doc["sensor"] = io::to_string(sensor);
   doc["mode"] = options.sequential ? "sequential" : "threaded";
+  if (const auto& vocabulary = slam.vocabulary_info()) {
+    doc["vocabulary"] = {{"path", vocabulary->path}, {"words", vocabulary->words}, {"load_ms", vocabulary->load_ms}};
+  } else {
+    doc["vocabulary"] = nullptr;
+  }
   doc["people_filter"] = slam.people_filter_enabled()
                              ? nlohmann::json{{"detector", slam.detector_name()},
                                               {"mode", run_settings.people_filter.mode},
@@ -205,6 +252,7 @@ RunSummary run_sequence(const RunOptions& options) {
   doc["summary"] = {{"frames", summary.frames},
                     {"tracked_frames", summary.tracked},
                     {"tracked_percent", summary.tracked_percent},
+                    {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
                     {"wall_time_s", wall_s},
                     {"throughput_fps", summary.throughput_fps},
                     {"tracking_ms_median", summary.tracking_ms_median},
@@ -228,6 +276,30 @@ RunSummary run_sequence(const RunOptions& options) {
                           {"fusion_ms_mean", mapper.fusion_ms_total / std::max(1, mapper.keyframes_processed)},
                           {"culling_ms_mean", mapper.culling_ms_total / std::max(1, mapper.keyframes_processed)},
                           {"keyframe_ms_mean", mapper.processing_ms_total / std::max(1, mapper.keyframes_processed)}};
+  if (slam.loop_closing_enabled()) {
+    const auto loops = slam.loop_stats();
+    nlohmann::json events = nlohmann::json::array();
+    for (const auto& e : loops.loops) {
+      events.push_back({{"keyframe", e.keyframe_id},
+                        {"loop_keyframe", e.loop_keyframe_id},
+                        {"timestamp", e.timestamp_s},
+                        {"loop_timestamp", e.loop_timestamp_s},
+                        {"matches", e.matches},
+                        {"correction_ms", e.correction_ms}});
+    }
+    doc["loop_closing"] = {
+        {"keyframes_checked", loops.keyframes_checked},
+        {"candidates_consistent", loops.candidates_consistent},
+        {"candidates_rejected", loops.candidates_rejected},
+        {"loops", events},
+        {"detection_ms_mean", loops.detection_ms_total / std::max(1, loops.keyframes_checked)},
+        {"global_ba_runs", loops.global_ba.runs},
+        {"global_ba_applied", loops.global_ba.applied},
+        {"global_ba_aborted", loops.global_ba.aborted},
+        {"global_ba_ms_mean", loops.global_ba.time_ms_total / std::max(1, loops.global_ba.runs)}};
+  } else {
+    doc["loop_closing"] = nullptr;
+  }
   doc["accuracy"] = accuracy;
   doc["frames"] = std::move(frames);
   summary.json = doc;

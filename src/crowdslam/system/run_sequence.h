@@ -29,12 +29,15 @@ struct RunOptions {
   std::string detector_model;       // --detector: body | coco | PATH.cfg | PATH.onnx
   std::string filter_mode;          // --filter-mode: overrides PeopleFilter.mode (paper | depth)
   size_t save_frames = 0;           // --save-frames N: every N-th frame drawn into OUT/frames/
+  std::string vocabulary;           // --vocabulary FILE | none ("" = the default vocabulary)
+  bool loop_closing = true;         // --no-loop-closing
 };
 
 struct RunSummary {
   size_t frames = 0;
   size_t tracked = 0;
   double tracked_percent = 0;
+  std::optional<size_t> init_frame;  // index of the first frame that initialised a map
   double throughput_fps = 0;
   double tracking_ms_median = 0;
   double tracking_ms_p95 = 0;

@@ -2,19 +2,44 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <future>
 
+#include "crowdslam/bow/vocabulary_path.h"
 #include "crowdslam/feature/orb_extractor.h"
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/people/darknet_detector.h"
 #include "crowdslam/people/model_paths.h"
 #include "crowdslam/people/mot_file_detector.h"
+#include "crowdslam/util/error.h"
 
 namespace crowdslam::system {
 
 namespace {
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+constexpr double kSparseDepthFactor = 1000.0;  // millimetres in the stereo sparse depth image
+
+// CV_16UC1 image (depth * factor, 0 = none) with each keypoint's stereo depth written into a square
+// block. people::estimate_person_depth samples a box every sqrt(area / 2000) pixels; blocks that wide are
+// sampled at least once, so every keypoint in a box's centre counts.
+cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vector<float>& depth_m, cv::Size size,
+                           double factor) {
+  cv::Mat image(size, CV_16UC1, cv::Scalar(0));
+  const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(size.area() / 2000.0))));
+  const cv::Rect inside(0, 0, size.width, size.height);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const double value = depth_m[i] * factor;
+    if (!(value > 0) || value > 65535) continue;
+    const cv::Rect block =
+        cv::Rect(cvRound(keys[i].pt.x) - side / 2, cvRound(keys[i].pt.y) - side / 2, side, side) & inside;
+    if (block.area() > 0) image(block).setTo(static_cast<uint16_t>(value));
+  }
+  return image;
 }
 }  // namespace
 
@@ -43,7 +68,12 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   builder_options.orb.ini_th_fast = settings.orb.ini_th_fast;
   builder_options.orb.min_th_fast = settings.orb.min_th_fast;
   builder_options.depth_map_factor = settings.depth_map_factor > 0 ? settings.depth_map_factor : 1.0;
+  load_vocabulary();
+  // Frames get their bag of words from tracking, only when needed (tracking/frame_bow.h).
   frame_builder_ = std::make_unique<tracking::FrameBuilder>(camera_, builder_options);
+  if (options.sensor == io::SensorKind::kStereo && settings.rectification) {
+    rectifier_ = std::make_unique<StereoRectifier>(*settings.rectification, settings.path);
+  }
 
   const double close_depth_m = camera_->bf > 0 ? settings.th_depth * camera_->bf / camera_->fx : 40.0;
   mapping::LocalMapperOptions mapper_options;
@@ -54,11 +84,56 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracking::TrackerOptions tracker_options;
   tracker_options.close_depth_m = close_depth_m;
   tracker_options.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
+  if (options.sensor == io::SensorKind::kMonocular) {
+    tracker_options.monocular = true;
+    tracker_options.local_map_radius_factor = 1.0;  // ORB-SLAM2's window for monocular local-map tracking
+  }
+  if (options.sensor == io::SensorKind::kStereo) {
+    // ORB-SLAM2 starts a stereo map from a frame with 500 keypoints; about half of them find a stereo
+    // partner (measured on EuRoC and the synthetic sequences), so ask for that many points with depth.
+    tracker_options.min_init_features = 250;
+  }
   tracker_ = std::make_unique<tracking::Tracker>(tracker_options, map_, mapper_.get());
+  if (vocabulary_) {
+    keyframe_database_ = std::make_unique<loop::KeyframeDatabase>();
+    mapper_->set_keyframe_database(keyframe_database_.get());
+    tracker_->set_keyframe_database(keyframe_database_.get());
+    tracker_->set_vocabulary(vocabulary_);
+    if (options.loop_closing) {
+      loop::LoopCloserOptions loop_options;
+      loop_options.fix_scale = options.sensor != io::SensorKind::kMonocular;
+      loop_closer_ = std::make_unique<loop::LoopCloser>(loop_options, map_, keyframe_database_.get(), mapper_.get());
+      mapper_->set_keyframe_done(
+          [closer = loop_closer_.get()](const std::shared_ptr<map::KeyFrame>& keyframe) { closer->insert_keyframe(keyframe); });
+      if (!options.sequential) loop_closer_->start();
+    }
+  }
 
   next_feature_budget_ = frame_builder_->default_num_features();
   if (options.people_filter && settings.people_filter.enabled) start_people_filter(settings);
   if (!options.sequential) mapper_->start();
+}
+
+void System::load_vocabulary() {
+  if (options_.vocabulary_path == "none") {
+    spdlog::info("no vocabulary: relocalisation by brute-force matching, no place recognition");
+    return;
+  }
+  const std::string path =
+      options_.vocabulary_path.empty() ? bow::default_vocabulary_path() : options_.vocabulary_path;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    vocabulary_ = std::make_shared<const bow::Vocabulary>(bow::Vocabulary::read(path));
+  } catch (const InputError& e) {
+    if (!options_.vocabulary_path.empty()) throw;
+    throw InputError(std::string(e.what()) +
+                     " (default vocabulary: build it with scripts/build_vocabulary.sh, point CROWDSLAM_VOCABULARY "
+                     "at one, or run with --vocabulary none)");
+  }
+  if (vocabulary_->empty()) throw input_error(path, "empty vocabulary");
+  vocabulary_info_ = VocabularyInfo{path, vocabulary_->num_words(), elapsed_ms(start)};
+  spdlog::info("vocabulary {}: {} words (k {}, L {}), loaded in {:.1f} ms", path, vocabulary_info_->words,
+               vocabulary_->k(), vocabulary_->levels(), vocabulary_info_->load_ms);
 }
 
 void System::start_people_filter(const io::Settings& settings) {
@@ -121,9 +196,18 @@ void System::filter_people(size_t frame_index, const io::FrameImages& images, tr
       if (d > 0) depth_m[i] = static_cast<float>(d / settings_.depth_map_factor);
     }
   }
-  const people::FilterResult filtered =
-      people::filter_keypoints(raw.keys, boxes, filter_options_, depth_m, rgbd ? images.depth : cv::Mat(),
-                               settings_.depth_map_factor > 0 ? settings_.depth_map_factor : 1.0);
+  // Stereo: the keypoints' depths come from stereo matching, which runs before the filter; each person's
+  // depth is estimated from them through a sparse depth image.
+  cv::Mat stereo_depth;
+  const bool stereo = options_.sensor == io::SensorKind::kStereo && raw.depth_m.size() == raw.keys.size();
+  if (filter_options_.mode == people::FilterMode::kDepth && stereo && !boxes.empty()) {
+    depth_m = raw.depth_m;
+    stereo_depth = sparse_depth_image(raw.keys, raw.depth_m, images.colour.size(), kSparseDepthFactor);
+  }
+  const double depth_factor =
+      stereo ? kSparseDepthFactor : (settings_.depth_map_factor > 0 ? settings_.depth_map_factor : 1.0);
+  const people::FilterResult filtered = people::filter_keypoints(
+      raw.keys, boxes, filter_options_, depth_m, rgbd ? images.depth : stereo_depth, depth_factor);
   if (filtered.removed > 0) {
     tracking::RawFeatures kept;
     kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));
@@ -133,6 +217,10 @@ void System::filter_people(size_t frame_index, const io::FrameImages& images, tr
       if (filtered.keep[i]) {
         raw.descriptors.row(static_cast<int>(i)).copyTo(kept.descriptors.row(row++));
         kept.keys.push_back(raw.keys[i]);
+        if (stereo) {
+          kept.right_u.push_back(raw.right_u[i]);
+          kept.depth_m.push_back(raw.depth_m[i]);
+        }
       } else if (options_.record_keypoints) {
         report.removed_keypoints.push_back(raw.keys[i]);
       }
@@ -156,6 +244,7 @@ void System::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   mapper_->stop();
+  if (loop_closer_) loop_closer_->stop();  // after the mapper: it may still hand over keyframes
 }
 
 FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
@@ -164,18 +253,60 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.timestamp_s = timestamp_s;
 
   const size_t frame_index = next_frame_id_;
-  // The detector works on this frame on its own thread while ORB features are extracted here.
-  if (detection_worker_) detection_worker_->submit(frame_index, images.colour);
-  const auto extraction_start = std::chrono::steady_clock::now();
-  const cv::Mat gray = feature::to_gray(images.colour);
-  tracking::RawFeatures raw;
+  const bool stereo = options_.sensor == io::SensorKind::kStereo;
+  if (stereo && images.right.empty()) {
+    throw InputError("frame " + std::to_string(frame_index) + ": stereo needs a right image");
+  }
   report.feature_budget = next_feature_budget_;
+  // Monocular initialisation extracts twice the features (ORB-SLAM2), for enough two-view matches.
+  if (options_.sensor == io::SensorKind::kMonocular &&
+      tracker_->state() == tracking::TrackingState::kNotInitialized) {
+    report.feature_budget *= 2;
+  }
+  const auto extraction_start = std::chrono::steady_clock::now();
+  // Stereo: the right image is rectified and its ORB extracted on a second thread meanwhile. Declared
+  // before the future, whose destructor waits for the thread, so they outlive it even on an exception.
+  cv::Mat right_gray;
+  tracking::RawFeatures raw_right;
+  std::future<void> right_done;
+  if (stereo) {
+    right_done = std::async(getenv("H5_SERIAL") ? std::launch::deferred : std::launch::async, [this, &images, &right_gray, &raw_right, budget = report.feature_budget] {
+      const cv::Mat gray = feature::to_gray(images.right);
+      if (rectifier_) {
+        rectifier_->rectify_right(gray, right_gray);
+      } else {
+        right_gray = gray;
+      }
+      frame_builder_->extract_right(right_gray, budget, raw_right);
+    });
+  }
+  cv::Mat left_colour = images.colour;
+  if (stereo && rectifier_) rectifier_->rectify_left(images.colour, left_colour);
+  // The detector works on this frame on its own thread while ORB features are extracted here.
+  if (detection_worker_) detection_worker_->submit(frame_index, left_colour);
+  const cv::Mat gray = feature::to_gray(left_colour);
+  tracking::RawFeatures raw;
   frame_builder_->extract(gray, report.feature_budget, raw);
   report.keypoints_before_filter = static_cast<int>(raw.keys.size());
+  if (stereo) {
+    // Matched before the people filter, whose depth mode needs the keypoints' depths.
+    const auto wait_start = std::chrono::steady_clock::now();
+    right_done.get();
+    report.right_wait_ms = elapsed_ms(wait_start);
+    const auto match_start = std::chrono::steady_clock::now();
+    frame_builder_->match_stereo(raw, raw_right);
+    report.stereo_match_ms = elapsed_ms(match_start);
+  }
   if (detection_worker_) filter_people(frame_index, images, raw, report);
-  const cv::Mat depth = options_.sensor == io::SensorKind::kRgbd ? images.depth : cv::Mat();
   if (options_.record_keypoints) report.kept_keypoints = raw.keys;
-  auto features = frame_builder_->assemble(std::move(raw), depth);
+  std::shared_ptr<map::FrameFeatures> features;
+  if (stereo) {
+    report.stereo_matches = static_cast<int>(std::count_if(raw.depth_m.begin(), raw.depth_m.end(), [](float d) { return d > 0; }));
+    features = frame_builder_->assemble_stereo(std::move(raw));
+  } else {
+    const cv::Mat depth = options_.sensor == io::SensorKind::kRgbd ? images.depth : cv::Mat();
+    features = frame_builder_->assemble(std::move(raw), depth);
+  }
   // Extraction time excludes the wait for the detector (reported on its own).
   report.extraction_ms = elapsed_ms(extraction_start) - report.detector_wait_ms;
   report.keypoints = static_cast<int>(features->size());
@@ -183,7 +314,10 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   const auto tracking_start = std::chrono::steady_clock::now();
   map::Frame frame(next_frame_id_++, timestamp_s, camera_, frame_builder_->levels(), std::move(features));
   const tracking::TrackResult result = tracker_->track(std::move(frame));
-  if (options_.sequential) mapper_->process_all();
+  if (options_.sequential) {
+    mapper_->process_all();
+    if (loop_closer_) loop_closer_->process_all();
+  }
   report.tracking_ms = elapsed_ms(tracking_start);
 
   report.state = result.state;
@@ -207,15 +341,21 @@ void System::reset_map() {
   ++map_resets_;
   const bool threaded = !options_.sequential;
   if (threaded) mapper_->stop();
+  if (loop_closer_) {
+    if (threaded) loop_closer_->stop();
+    loop_closer_->reset();
+  }
   mapper_->reset();
   // Frames tracked against the discarded map live in another coordinate frame: drop them.
   for (auto& r : records_) {
     r.tracked = false;
     r.reference.reset();
   }
+  if (keyframe_database_) keyframe_database_->clear();
   map_->clear();
   tracker_->reset();
   if (threaded) mapper_->start();
+  if (threaded && loop_closer_) loop_closer_->start();
 }
 
 io::Trajectory System::camera_trajectory() const {
@@ -249,5 +389,7 @@ io::Trajectory System::keyframe_trajectory() const {
 size_t System::num_keyframes() const { return map_->num_keyframes(); }
 size_t System::num_map_points() const { return map_->num_map_points(); }
 mapping::LocalMapperStats System::mapper_stats() const { return mapper_->stats(); }
+
+loop::LoopCloserStats System::loop_stats() const { return loop_closer_ ? loop_closer_->stats() : loop::LoopCloserStats{}; }
 
 }  // namespace crowdslam::system

@@ -5,13 +5,17 @@
 #include <optional>
 #include <vector>
 
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/io/settings.h"
 #include "crowdslam/io/trajectory.h"
+#include "crowdslam/loop/keyframe_database.h"
+#include "crowdslam/loop/loop_closer.h"
 #include "crowdslam/mapping/local_mapper.h"
 #include "crowdslam/people/detection_worker.h"
 #include "crowdslam/people/feature_budget.h"
 #include "crowdslam/people/keypoint_filter.h"
+#include "crowdslam/system/stereo_rectifier.h"
 #include "crowdslam/tracking/frame_builder.h"
 #include "crowdslam/tracking/tracker.h"
 
@@ -26,6 +30,19 @@ struct SystemOptions {
   std::string detections_file;
   std::string detector_model;  // overrides Detector.model_cfg: "body", "coco", a .cfg or .onnx path
   bool record_keypoints = false;  // fill FrameReport::kept_keypoints / removed_keypoints (for drawing)
+  // ORB vocabulary for place recognition (relocalisation with the keyframe database, bag-of-words
+  // matching): "" = bow::default_vocabulary_path(), "none" = no vocabulary (brute-force relocalisation).
+  // A missing or invalid file is an InputError naming it, thrown by the constructor.
+  std::string vocabulary_path;
+  // Loop closing thread (needs a vocabulary). Off: tracking, mapping and relocalisation only.
+  bool loop_closing = true;
+};
+
+// The vocabulary a System loaded, for run.json.
+struct VocabularyInfo {
+  std::string path;
+  size_t words = 0;
+  double load_ms = 0;
 };
 
 // What happened to one frame, for run.json.
@@ -46,6 +63,11 @@ struct FrameReport {
   int keypoints_before_filter = 0;
   double detector_ms = 0;      // detector forward time (runs on its own thread)
   double detector_wait_ms = 0; // how long tracking waited for the boxes after ORB extraction
+  // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
+  // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).
+  int stereo_matches = 0;
+  double right_wait_ms = 0;
+  double stereo_match_ms = 0;
   std::vector<people::PersonBox> boxes;  // used for filtering (for --save-frames)
   std::vector<cv::KeyPoint> removed_keypoints;  // only with SystemOptions::record_keypoints
   std::vector<cv::KeyPoint> kept_keypoints;
@@ -58,7 +80,8 @@ class System {
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  // Processes one frame (colour BGR or grey; depth raw CV_16UC1 for RGB-D).
+  // Processes one frame (colour BGR or grey; depth raw CV_16UC1 for RGB-D; right image for stereo,
+  // rectified here when the settings have LEFT/RIGHT blocks). Throws InputError for a missing right image.
   FrameReport track(const io::FrameImages& images, double timestamp_s);
   // Lets local mapping finish and stops its thread (idempotent; the destructor calls it).
   void shutdown();
@@ -70,9 +93,14 @@ class System {
   [[nodiscard]] size_t num_keyframes() const;
   [[nodiscard]] size_t num_map_points() const;
   [[nodiscard]] mapping::LocalMapperStats mapper_stats() const;
+  // Empty statistics when loop closing is off.
+  [[nodiscard]] loop::LoopCloserStats loop_stats() const;
+  [[nodiscard]] bool loop_closing_enabled() const { return loop_closer_ != nullptr; }
   [[nodiscard]] int map_resets() const { return map_resets_; }
   [[nodiscard]] bool people_filter_enabled() const { return detection_worker_ != nullptr; }
   [[nodiscard]] std::string detector_name() const;
+  // Empty when running without a vocabulary.
+  [[nodiscard]] const std::optional<VocabularyInfo>& vocabulary_info() const { return vocabulary_info_; }
 
  private:
   struct TrajectoryRecord {
@@ -82,6 +110,8 @@ class System {
     bool tracked = false;
   };
   void reset_map();
+  // Reads options_.vocabulary_path into vocabulary_ (nothing for "none"); throws InputError.
+  void load_vocabulary();
   void start_people_filter(const io::Settings& settings);
   // Waits for the frame's boxes and removes the keypoints on people; updates the next frame's budget.
   void filter_people(size_t frame_index, const io::FrameImages& images, tracking::RawFeatures& raw,
@@ -91,7 +121,12 @@ class System {
   SystemOptions options_;
   std::shared_ptr<geometry::PinholeCamera> camera_;
   std::shared_ptr<map::Map> map_;
+  std::shared_ptr<const bow::Vocabulary> vocabulary_;  // null without a vocabulary
+  std::optional<VocabularyInfo> vocabulary_info_;
+  std::unique_ptr<loop::KeyframeDatabase> keyframe_database_;  // with a vocabulary only
+  std::unique_ptr<loop::LoopCloser> loop_closer_;               // with a vocabulary and loop closing on
   std::unique_ptr<tracking::FrameBuilder> frame_builder_;
+  std::unique_ptr<StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   std::vector<TrajectoryRecord> records_;

@@ -1,10 +1,14 @@
 #include "crowdslam/tracking/relocalizer.h"
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
 #include <opencv2/calib3d.hpp>
 #include <unordered_set>
 
 #include "crowdslam/feature/descriptor.h"
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/match/bow_search.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/tracking/pose_refinement.h"
 
@@ -50,6 +54,19 @@ std::vector<std::pair<size_t, std::shared_ptr<map::MapPoint>>> match_by_descript
   return matches;
 }
 
+// Frame keypoint index -> map point through the vocabulary's direct index.
+std::vector<std::pair<size_t, std::shared_ptr<map::MapPoint>>> match_by_bow(const map::Frame& frame,
+                                                                            const map::KeyFrame& candidate,
+                                                                            double ratio) {
+  std::vector<std::shared_ptr<map::MapPoint>> slots;
+  match::search_by_bow(candidate, frame, slots, ratio, true);
+  std::vector<std::pair<size_t, std::shared_ptr<map::MapPoint>>> matches;
+  for (size_t i = 0; i < slots.size(); ++i) {
+    if (slots[i]) matches.emplace_back(i, std::move(slots[i]));
+  }
+  return matches;
+}
+
 // Optimises the pose and drops the outlier matches; returns the inliers.
 int optimize_and_count(map::Frame& frame, const optim::PoseOptimizerOptions& pose_options) {
   const int inliers = optimize_frame_pose(frame, pose_options);
@@ -62,23 +79,38 @@ int optimize_and_count(map::Frame& frame, const optim::PoseOptimizerOptions& pos
 std::shared_ptr<map::KeyFrame> Relocalizer::relocalize(map::Frame& frame,
                                                        const std::vector<std::shared_ptr<map::KeyFrame>>& candidates,
                                                        const optim::PoseOptimizerOptions& pose_options) const {
+  const bool frame_bow = frame.features->has_bow();
+  // Bag-of-words matching is cheap: match every candidate first and try the best matched first.
+  std::vector<std::pair<std::shared_ptr<map::KeyFrame>, Matches>> by_bow;
   for (const auto& candidate : candidates) {
     if (!candidate || candidate->is_bad()) continue;
-    if (try_candidate(frame, *candidate, pose_options)) return candidate;
+    if (frame_bow && candidate->features->has_bow()) {
+      auto matches = match_by_bow(frame, *candidate, options_.ratio);
+      if (static_cast<int>(matches.size()) >= options_.min_matches) by_bow.emplace_back(candidate, std::move(matches));
+      continue;
+    }
+    // Brute force, in the order given.
+    const auto points = candidate->valid_map_points();
+    if (static_cast<int>(points.size()) < options_.min_matches) continue;
+    const auto matches = match_by_descriptor(frame, points, options_.ratio, options_.max_distance);
+    if (static_cast<int>(matches.size()) < options_.min_matches) continue;
+    if (try_candidate(frame, *candidate, matches, pose_options)) return candidate;
+  }
+  std::stable_sort(by_bow.begin(), by_bow.end(),
+                   [](const auto& a, const auto& b) { return a.second.size() > b.second.size(); });
+  for (const auto& [candidate, matches] : by_bow) {
+    if (try_candidate(frame, *candidate, matches, pose_options)) return candidate;
   }
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  std::fill(frame.outliers.begin(), frame.outliers.end(), false);
   frame.cam_from_world.reset();
   return nullptr;
 }
 
-bool Relocalizer::try_candidate(map::Frame& frame, const map::KeyFrame& candidate,
+bool Relocalizer::try_candidate(map::Frame& frame, const map::KeyFrame& candidate, const Matches& matches,
                                 const optim::PoseOptimizerOptions& pose_options) const {
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-  const auto points = candidate.valid_map_points();
-  if (static_cast<int>(points.size()) < options_.min_matches) return false;
-  const auto matches = match_by_descriptor(frame, points, options_.ratio, options_.max_distance);
-  if (static_cast<int>(matches.size()) < options_.min_matches) return false;
 
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
@@ -107,11 +139,32 @@ bool Relocalizer::try_candidate(map::Frame& frame, const map::KeyFrame& candidat
     frame.map_points[i] = p;
   }
   int good = optimize_and_count(frame, pose_options);
-  if (good < options_.min_pnp_inliers) return false;
+  if (good < options_.min_optimized_inliers) return false;
 
-  // More matches by projecting the candidate's neighbourhood with the new pose.
+  // Too few inliers: more matches by projecting the candidate's neighbourhood with the new pose (wide
+  // window), optimise again; if that lands between retry_min_inliers and min_final_inliers, a narrow
+  // search with the better pose and a tighter descriptor threshold (ORB-SLAM2's two stages).
+  if (good < options_.min_final_inliers) {
+    const int additional = search_by_projection(frame, candidate, options_.wide_radius_factor, kNoDistanceLimit);
+    if (good + additional < options_.min_final_inliers) return false;
+    good = optimize_and_count(frame, pose_options);
+    if (good > options_.retry_min_inliers && good < options_.min_final_inliers) {
+      const int more = search_by_projection(frame, candidate, options_.narrow_radius_factor, options_.max_distance);
+      if (good + more >= options_.min_final_inliers) good = optimize_and_count(frame, pose_options);
+    }
+  }
+  spdlog::debug("relocalisation against keyframe {}: {} matches, {} PnP inliers, {} final inliers", candidate.id,
+                matches.size(), inliers.size(), good);
+  return good >= options_.min_final_inliers;
+}
+
+int Relocalizer::search_by_projection(map::Frame& frame, const map::KeyFrame& candidate, double radius_factor,
+                                      int max_distance) const {
   std::unordered_set<const map::MapPoint*> already;
-  for (const auto& p : frame.map_points) {
+  std::vector<bool> was_free(frame.map_points.size());
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    was_free[i] = !p;
     if (p) already.insert(p.get());
   }
   std::vector<match::ProjectedPoint> projected;
@@ -124,9 +177,19 @@ bool Relocalizer::try_candidate(map::Frame& frame, const map::KeyFrame& candidat
   };
   add_points(candidate);
   for (const auto& neighbour : candidate.best_covisible(10)) add_points(*neighbour);
-  match::search_local_points(frame, projected, 3.0, 0.9);
-  good = optimize_and_count(frame, pose_options);
-  return good >= options_.min_final_inliers;
+  match::search_local_points(frame, projected, radius_factor, 0.9);
+  int added = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!was_free[i] || !p) continue;
+    if (max_distance != kNoDistanceLimit &&
+        feature::hamming_distance(p->descriptor().data(), frame.features->descriptor(i)) > max_distance) {
+      p.reset();
+      continue;
+    }
+    ++added;
+  }
+  return added;
 }
 
 }  // namespace crowdslam::tracking

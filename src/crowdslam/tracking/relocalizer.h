@@ -1,10 +1,15 @@
 #pragma once
 // Relocalisation after tracking is lost: the frame is matched by descriptor against candidate keyframes'
 // map points, a pose is found by PnP with RANSAC and refined by motion-only optimisation; more matches
-// then come from projecting the candidate's covisible map points. Until the bag-of-words vocabulary
-// exists, candidates are chosen by recency and covisibility and matching is brute force (a few ms per
-// candidate), which is affordable because it only runs while lost.
+// then come from projecting the candidate's covisible map points.
+//
+// With a bag of words on both the frame and a candidate, matching uses the vocabulary's direct index
+// (match::search_by_bow) and the candidates are tried in decreasing number of matches; the caller picks
+// the candidates with the keyframe database. Without a vocabulary, matching is brute force against each
+// candidate's points in the order given (a few ms per candidate, affordable because it only runs while
+// lost).
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "crowdslam/map/frame.h"
@@ -16,11 +21,17 @@ namespace crowdslam::tracking {
 struct RelocalizerOptions {
   int min_matches = 15;          // descriptor matches needed to try PnP with a candidate
   int min_pnp_inliers = 12;
+  int min_optimized_inliers = 10;  // after the first pose optimisation
   int min_final_inliers = 50;    // inliers after optimisation and projection search
+  // Between this and min_final_inliers after the wide projection search, a second, narrow one is tried
+  // (ORB-SLAM2's two-stage search).
+  int retry_min_inliers = 30;
   double ratio = 0.75;           // nearest / second nearest Hamming distance
-  int max_distance = 64;         // Hamming
+  int max_distance = 64;         // Hamming, brute-force matching and the narrow projection search
   int ransac_iterations = 200;
   double ransac_reprojection_px = 4.0;
+  double wide_radius_factor = 3.0;    // projection search windows (see match::search_local_points)
+  double narrow_radius_factor = 1.0;
 };
 
 class Relocalizer {
@@ -34,8 +45,14 @@ class Relocalizer {
                                             const optim::PoseOptimizerOptions& pose_options) const;
 
  private:
-  bool try_candidate(map::Frame& frame, const map::KeyFrame& candidate,
+  using Matches = std::vector<std::pair<size_t, std::shared_ptr<map::MapPoint>>>;  // frame keypoint, point
+  bool try_candidate(map::Frame& frame, const map::KeyFrame& candidate, const Matches& matches,
                      const optim::PoseOptimizerOptions& pose_options) const;
+  // Matches from projecting the candidate's and its neighbours' points (new matches farther than
+  // max_distance are dropped unless it is kNoDistanceLimit); returns how many were added.
+  int search_by_projection(map::Frame& frame, const map::KeyFrame& candidate, double radius_factor,
+                           int max_distance) const;
+  static constexpr int kNoDistanceLimit = -1;
   RelocalizerOptions options_;
 };
 

@@ -7,8 +7,11 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "crowdslam/loop/keyframe_database.h"
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/match/bow_search.h"
 #include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/tracking/frame_bow.h"
 #include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/util/error.h"
 
@@ -31,10 +34,11 @@ void TrackerOptions::check() const {
   if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
   if (max_frames_between_keyframes < 1) throw InputError("tracker: max frames between keyframes must be >= 1");
   pose.check();
+  if (monocular) monocular_init.check();
 }
 
 Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, KeyframeConsumer* mapper)
-    : options_(options), map_(std::move(map)), mapper_(mapper) {
+    : options_(options), map_(std::move(map)), mapper_(mapper), monocular_initializer_(options.monocular_init) {
   options_.check();
 }
 
@@ -48,6 +52,7 @@ void Tracker::reset() {
   temporal_points_.clear();
   local_keyframes_.clear();
   local_points_.clear();
+  monocular_initializer_.reset();
 }
 
 TrackResult Tracker::track(map::Frame frame) {
@@ -56,7 +61,7 @@ TrackResult Tracker::track(map::Frame frame) {
   std::unique_lock map_lock(map_->update_mutex());
 
   if (state_ == TrackingState::kNotInitialized) {
-    if (initialize(frame)) {
+    if (options_.monocular ? initialize_monocular(frame) : initialize(frame)) {
       state_ = TrackingState::kOk;
       result.method = "init";
       result.new_keyframe = true;
@@ -120,6 +125,7 @@ TrackResult Tracker::track(map::Frame frame) {
 
 // ---- initialisation (RGB-D / stereo: one frame with depth) ----
 bool Tracker::initialize(map::Frame& frame) {
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);  // the first keyframe carries its bag of words
   const auto& f = *frame.features;
   int with_depth = 0;
   for (size_t i = 0; i < f.size(); ++i) {
@@ -164,18 +170,24 @@ std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& 
 
 // ---- relocalisation ----
 bool Tracker::relocalize(map::Frame& frame) {
-  // Candidates: the reference keyframe and its neighbours, then the most recent keyframes.
   std::vector<std::shared_ptr<map::KeyFrame>> candidates;
-  std::unordered_set<uint64_t> seen;
-  auto add = [&](const std::shared_ptr<map::KeyFrame>& kf) {
-    if (kf && !kf->is_bad() && seen.insert(kf->id).second) candidates.push_back(kf);
-  };
-  if (reference_keyframe_) {
-    add(reference_keyframe_);
-    for (const auto& kf : reference_keyframe_->best_covisible(5)) add(kf);
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);
+  if (database_ && frame.features->has_bow()) {
+    // Place recognition: keyframes that look like the frame.
+    candidates = database_->relocalization_candidates(*frame.features);
+  } else {
+    // No vocabulary: the reference keyframe and its neighbours, then the most recent keyframes.
+    std::unordered_set<uint64_t> seen;
+    auto add = [&](const std::shared_ptr<map::KeyFrame>& kf) {
+      if (kf && !kf->is_bad() && seen.insert(kf->id).second) candidates.push_back(kf);
+    };
+    if (reference_keyframe_) {
+      add(reference_keyframe_);
+      for (const auto& kf : reference_keyframe_->best_covisible(5)) add(kf);
+    }
+    const auto all = map_->keyframes();
+    for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 16; ++it) add(*it);
   }
-  const auto all = map_->keyframes();
-  for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 16; ++it) add(*it);
   const auto keyframe = relocalizer_.relocalize(frame, candidates, options_.pose);
   if (!keyframe) return false;
   reference_keyframe_ = keyframe;
@@ -243,8 +255,15 @@ bool Tracker::track_with_motion_model(map::Frame& frame) {
 
 bool Tracker::track_reference_keyframe(map::Frame& frame) {
   if (!reference_keyframe_ || !last_frame_ || !last_frame_->cam_from_world) return false;
-  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-  const int matches = match::search_keyframe_window(frame, *reference_keyframe_, options_.keyframe_window_radius);
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);
+  int matches = 0;
+  if (frame.features->has_bow() && reference_keyframe_->features->has_bow()) {
+    // Bag-of-words guided matching (no pose guess needed).
+    matches = match::search_by_bow(*reference_keyframe_, frame, frame.map_points, 0.7, true);
+  } else {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    matches = match::search_keyframe_window(frame, *reference_keyframe_, options_.keyframe_window_radius);
+  }
   if (matches < 15) return false;
   frame.cam_from_world = *last_frame_->cam_from_world;
   optimize_pose(frame);
@@ -348,6 +367,7 @@ bool Tracker::track_local_map(map::Frame& frame) {
 
 // ---- keyframes ----
 bool Tracker::need_new_keyframe(const map::Frame& frame) const {
+  if (options_.monocular) return need_new_keyframe_monocular(frame);
   if (mapper_->is_paused()) return false;
   const size_t num_keyframes = map_->num_keyframes();
   const auto max_frames = static_cast<uint64_t>(options_.max_frames_between_keyframes);
@@ -386,6 +406,7 @@ bool Tracker::need_new_keyframe(const map::Frame& frame) const {
 }
 
 void Tracker::create_new_keyframe(map::Frame& frame) {
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);  // keyframes carry their bag of words
   auto keyframe = std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
                                                   frame.levels, frame.features, *frame.cam_from_world);
   // The keyframe takes the frame's current matches (the mapper adds the observations).

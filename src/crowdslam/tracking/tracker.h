@@ -6,12 +6,18 @@
 #include <memory>
 #include <optional>
 
+#include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/map/frame.h"
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map.h"
 #include "crowdslam/optim/pose_optimizer.h"
 #include "crowdslam/tracking/keyframe_consumer.h"
+#include "crowdslam/tracking/monocular_initializer.h"
 #include "crowdslam/tracking/relocalizer.h"
+
+namespace crowdslam::loop {
+class KeyframeDatabase;
+}
 
 namespace crowdslam::tracking {
 
@@ -32,6 +38,10 @@ struct TrackerOptions {
   double keyframe_reference_ratio = 0.9;
   int reset_if_lost_within_keyframes = 5;  // lost with so few keyframes: reset the map and start again
   optim::PoseOptimizerOptions pose;
+  // Monocular: two-view initialisation, ORB-SLAM2's monocular keyframe policy, points only by
+  // triangulation (local mapper). See tracker_monocular.cpp.
+  bool monocular = false;
+  MonocularInitializerOptions monocular_init;
   void check() const;
 };
 
@@ -54,12 +64,21 @@ class Tracker {
   // Tracks one frame; `frame` is consumed (kept as the last frame).
   TrackResult track(map::Frame frame);
 
+  // Place recognition for relocalisation (optional; not owned). With it, frames that have a bag of words
+  // relocalise against the database's candidates; without it, against recent keyframes (brute force).
+  void set_keyframe_database(const loop::KeyframeDatabase* database) { database_ = database; }
+  // Vocabulary for bags of words computed on demand (see frame_bow.h): for keyframes, reference-keyframe
+  // tracking and relocalisation. Without it only frames built with a bag of words use one.
+  void set_vocabulary(std::shared_ptr<const bow::Vocabulary> vocabulary) { vocabulary_ = std::move(vocabulary); }
+
   [[nodiscard]] TrackingState state() const { return state_; }
   [[nodiscard]] const map::Frame* last_frame() const { return last_frame_ ? &*last_frame_ : nullptr; }
   void reset();
 
  private:
   bool initialize(map::Frame& frame);
+  bool initialize_monocular(map::Frame& frame);                   // tracker_monocular.cpp
+  bool need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);
   bool track_reference_keyframe(map::Frame& frame);
   bool track_local_map(map::Frame& frame);
@@ -77,6 +96,9 @@ class Tracker {
   std::shared_ptr<map::Map> map_;
   KeyframeConsumer* mapper_;
   Relocalizer relocalizer_;
+  MonocularInitializer monocular_initializer_;
+  const loop::KeyframeDatabase* database_ = nullptr;
+  std::shared_ptr<const bow::Vocabulary> vocabulary_;
 
   TrackingState state_ = TrackingState::kNotInitialized;
   std::optional<map::Frame> last_frame_;

@@ -1,0 +1,16 @@
+#pragma once
+// Bag of words computed on demand. Transforming a frame's descriptors costs about 0.6 ms (a tree descent
+// per descriptor, mostly cache misses) and most frames never need it: only keyframes (keyframe database,
+// loop closing), reference-keyframe tracking and relocalisation use it. So, as in ORB-SLAM2, tracking
+// computes it when one of those needs it rather than for every frame.
+#include "crowdslam/bow/vocabulary.h"
+#include "crowdslam/map/frame.h"
+
+namespace crowdslam::tracking {
+
+// Gives frame.features its bag of words and direct index if it has none yet: the features are shared and
+// immutable, so the frame gets a copy that has them (the descriptor matrix is shared, not copied).
+// No-op for a frame that has them or has no descriptors.
+void ensure_bow(map::Frame& frame, const bow::Vocabulary& vocabulary);
+
+}  // namespace crowdslam::tracking
