@@ -28,8 +28,10 @@ namespace crowdslam::bow {
 
 inline constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 inline constexpr std::uint32_t kNoWord = 0xFFFFFFFFu;
-// Default direct-index level, counted up from the leaves (ORB-SLAM2 uses 4 with a 6-level tree).
-inline constexpr int kDefaultLevelsUp = 4;
+// Default direct-index level, counted up from the leaves. ORB-SLAM2 indexes its 6-level tree 4 levels up,
+// i.e. at level 2 (100 nodes for k = 10); with our default 5-level tree 3 levels up is that same level
+// (4 would leave 10 groups, too coarse to speed up matching).
+inline constexpr int kDefaultLevelsUp = 3;
 
 // Where training is: `level` (1..L) is the tree level being built, `descriptors_done` of
 // `descriptors_total` the descriptors whose node at that level has been clustered.

@@ -5,11 +5,15 @@
 #include <spdlog/spdlog.h>
 
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/tracking/frame_bow.h"
 #include "crowdslam/tracking/tracker.h"
 
 namespace crowdslam::tracking {
 
 bool Tracker::initialize_monocular(map::Frame& frame) {
+  // Either frame may become one of the two first keyframes, which need their bag of words (keyframe
+  // database, loop closing): computed before the initializer keeps a copy of the frame.
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);
   const auto init = monocular_initializer_.add_frame(frame);
   if (!init) return false;
   const auto keyframes = build_initial_map(*map_, *init, frame, options_.monocular_init);
