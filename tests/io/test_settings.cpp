@@ -250,6 +250,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadValue{"Detector.model_cfg", "Detector.model_cfg: 3", "Detector.model_cfg: expected a string"},
         BadValue{"PeopleFilter.mode", "PeopleFilter.mode: \"boxes\"",
                  "PeopleFilter.mode: must be \"paper\" or \"depth\""},
+        BadValue{"PeopleFilter.right_image", "PeopleFilter.right_image: \"both\"",
+                 "PeopleFilter.right_image: must be \"matched\" or \"boxes\""},
         BadValue{"PeopleFilter.margin_px", "PeopleFilter.margin_px: -2",
                  "PeopleFilter.margin_px: must be >= 0"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: [ 0.0, 0.6, 0.3, 0.9, 0.95 ]",

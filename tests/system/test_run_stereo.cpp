@@ -127,3 +127,44 @@ TEST(RunStereo, PeopleFilterDropsLeftKeypointsInsideBoxes) {
   }
   EXPECT_GT(frames_with_removal, 5);
 }
+
+// PeopleFilter.right_image: "boxes" also drops the stereo match of a kept left keypoint whose right
+// coordinate falls in a person box (boxes of the left image, unshifted); "matched" never does.
+TEST(RunStereo, RightImageBoxesModeDropsStereoMatchesInBoxes) {
+  test::TempDir tmp;
+  synth::SynthOptions synth_options;
+  synth_options.frames = 30;
+  synth_options.width = 320;
+  synth_options.height = 240;
+  synth_options.people = 3;
+  synth_options.stereo = true;
+  synth::write_sequence(synth_options, tmp / "seq");
+
+  auto run = [&](const std::string& right_image) {
+    auto dataset = io::open_dataset((tmp / "seq").string());
+    io::Settings settings = io::load_settings((tmp / "seq" / "settings.yaml").string(), io::SensorKind::kStereo);
+    settings.people_filter.right_image = right_image;
+    system::SystemOptions options;
+    options.sensor = io::SensorKind::kStereo;
+    options.sequential = true;
+    options.detections_file = (tmp / "seq" / "people_gt.txt").string();
+    system::System slam(settings, options);
+    int removed = 0;
+    int matches = 0;
+    while (auto frame = dataset->next()) {
+      const auto r = slam.track(frame->images, frame->info.timestamp_s);
+      if (r.boxes.empty()) {
+        EXPECT_EQ(r.right_keypoints_removed, 0);
+      }
+      removed += r.right_keypoints_removed;
+      matches += r.stereo_matches;
+    }
+    return std::make_pair(removed, matches);
+  };
+  const auto matched = run("matched");
+  const auto boxes = run("boxes");
+  EXPECT_EQ(matched.first, 0);
+  EXPECT_GT(boxes.first, 0);
+  // Each removal turns one stereo keypoint into a monocular one.
+  EXPECT_LT(boxes.second, matched.second);
+}

@@ -76,6 +76,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.text("PeopleFilter.mode"), s.people_filter.mode);
   set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
   set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
+  set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
   set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
   set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);
@@ -150,7 +151,8 @@ bool operator==(const Settings& a, const Settings& b) {
   const bool people = a.people_filter.enabled == b.people_filter.enabled &&
                       a.people_filter.mode == b.people_filter.mode &&
                       a.people_filter.margin_px == b.people_filter.margin_px &&
-                      a.people_filter.depth_margin_m == b.people_filter.depth_margin_m;
+                      a.people_filter.depth_margin_m == b.people_filter.depth_margin_m &&
+                      a.people_filter.right_image == b.people_filter.right_image;
   const bool budget = a.feature_budget.enabled == b.feature_budget.enabled &&
                       a.feature_budget.thresholds == b.feature_budget.thresholds &&
                       a.feature_budget.factors == b.feature_budget.factors &&

@@ -128,6 +128,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(p.mode == "paper" || p.mode == "depth", "PeopleFilter.mode", "\"paper\" or \"depth\"",
             "\"" + p.mode + "\"");
   c.require(std::isfinite(p.margin_px) && p.margin_px >= 0, "PeopleFilter.margin_px", ">= 0", p.margin_px);
+  c.require(p.right_image == "matched" || p.right_image == "boxes", "PeopleFilter.right_image",
+            "\"matched\" or \"boxes\"", "\"" + p.right_image + "\"");
   c.require(std::isfinite(p.depth_margin_m) && p.depth_margin_m >= 0, "PeopleFilter.depth_margin_m", ">= 0",
             p.depth_margin_m);
   const auto& b = s.feature_budget;

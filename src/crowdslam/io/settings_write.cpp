@@ -89,7 +89,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
   const auto& p = s.people_filter;
   out << "# Keypoints on people (mode \"paper\" or \"depth\")\nPeopleFilter.enabled: " << (p.enabled ? 1 : 0)
       << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
-      << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m) << "\n\n";
+      << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
+      << "\nPeopleFilter.right_image: " << quoted(p.right_image) << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "

@@ -67,6 +67,7 @@ nlohmann::json frame_json(const FrameReport& r) {
           {"detector_ms", r.detector_ms},
           {"detector_wait_ms", r.detector_wait_ms},
           {"stereo_matches", r.stereo_matches},
+          {"right_keypoints_removed", r.right_keypoints_removed},
           {"right_wait_ms", r.right_wait_ms},
           {"stereo_match_ms", r.stereo_match_ms},
           {"timestamp", r.timestamp_s},

@@ -161,6 +161,7 @@ void System::start_people_filter(const io::Settings& settings) {
   filter_options_.mode = people::parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
   filter_options_.margin_px = settings.people_filter.margin_px;
   filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
+  right_image_boxes_ = settings.people_filter.right_image == "boxes";
   filter_options_.check();
   filter_before_nms_ = settings.detector.filter_before_nms;
 
@@ -226,6 +227,21 @@ void System::filter_people(size_t frame_index, const io::FrameImages& images, tr
       }
     }
     raw = std::move(kept);
+  }
+  if (stereo && right_image_boxes_) {
+    // The boxes are the left image's, used unshifted on the right image.
+    for (size_t i = 0; i < raw.keys.size(); ++i) {
+      if (raw.right_u[i] < 0) continue;
+      const cv::Point2f right(raw.right_u[i], raw.keys[i].pt.y);
+      for (const auto& box : boxes) {
+        if (box.box.contains(right)) {
+          raw.right_u[i] = -1.0f;
+          raw.depth_m[i] = -1.0f;
+          ++report.right_keypoints_removed;
+          break;
+        }
+      }
+    }
   }
   // Feature number update for the next frame.
   budget_options_.image_width = images.colour.cols;

@@ -63,6 +63,7 @@ struct FrameReport {
   int keypoints_before_filter = 0;
   double detector_ms = 0;      // detector forward time (runs on its own thread)
   double detector_wait_ms = 0; // how long tracking waited for the boxes after ORB extraction
+  int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
   // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).
   int stereo_matches = 0;
@@ -135,6 +136,7 @@ class System {
   people::FeatureBudgetOptions budget_options_;
   people::AreaMode area_mode_ = people::AreaMode::kSum;
   bool filter_before_nms_ = true;
+  bool right_image_boxes_ = false;  // PeopleFilter.right_image: boxes
   int next_feature_budget_ = 0;
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;
