@@ -143,6 +143,12 @@ run_sanitizer() {
     "$bin" run --dataset "$seq" --out "$out/run_detector" || true
   run_step "$tag run synth (no people filter)" "$out/run_nofilter.log" \
     "$bin" run --dataset "$seq" --out "$out/run_nofilter" --no-people-filter || true
+  # Two laps with noisy depth: a loop is closed, so loop correction and the global-BA thread run.
+  run_step "$tag synth (two laps)" "$out/synth_loop.log" \
+    "$bin" synth --out "$out/loop_sequence" --frames 600 --noise-depth 0.05 --width 480 --height 360 --force ||
+    return 0
+  run_step "$tag run synth two laps (loop closing)" "$out/run_loop.log" \
+    "$bin" run --dataset "$out/loop_sequence" --out "$out/run_loop" --no-people-filter || true
   if [[ -f "$bonn/rgb.txt" ]]; then
     run_step "$tag run bonn_crowd ($bonn_frames frames, depth filter)" "$out/run_bonn.log" \
       "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --filter-mode depth \
