@@ -230,30 +230,38 @@ Mat3 fundamental_eight_point(const std::vector<Vec2>& points1, const std::vector
   return unit_frobenius(n2.transform.transpose() * f2 * n1.transform);
 }
 
+namespace {
+// ORB-SLAM's two-way model score: each direction's chi2 (error^2 / sigma^2) adds kChi2Mono - chi2 to the
+// score when below `inlier_chi2`; a match is an inlier when both directions are.
+template <typename ErrorIn2, typename ErrorIn1>
+void score_both_ways(ModelScore& out, const std::vector<Vec2>& points1, const std::vector<Vec2>& points2,
+                     double sigma_px, double inlier_chi2, ErrorIn2 error_in_2, ErrorIn1 error_in_1) {
+  const double inv_sigma2 = 1.0 / (sigma_px * sigma_px);
+  for (size_t i = 0; i < points1.size(); ++i) {
+    bool inlier = true;
+    for (const double chi2 : {error_in_2(points1[i], points2[i]) * inv_sigma2,
+                              error_in_1(points2[i], points1[i]) * inv_sigma2}) {
+      if (chi2 > inlier_chi2) {
+        inlier = false;
+      } else {
+        out.score += kChi2Mono - chi2;
+      }
+    }
+    out.inliers[i] = inlier;
+    if (inlier) ++out.num_inliers;
+  }
+}
+}  // namespace
+
 ModelScore score_homography(const Mat3& homography_21, const std::vector<Vec2>& points1,
                             const std::vector<Vec2>& points2, double sigma_px) {
   ModelScore out;
   out.inliers.assign(points1.size(), false);
   const Mat3 homography_12 = homography_21.inverse();
   if (!homography_12.allFinite()) return out;
-  const double inv_sigma2 = 1.0 / (sigma_px * sigma_px);
-  for (size_t i = 0; i < points1.size(); ++i) {
-    bool inlier = true;
-    const double chi2_in_2 = transfer_error_squared(homography_21, points1[i], points2[i]) * inv_sigma2;
-    if (chi2_in_2 > kChi2Mono) {
-      inlier = false;
-    } else {
-      out.score += kChi2Mono - chi2_in_2;
-    }
-    const double chi2_in_1 = transfer_error_squared(homography_12, points2[i], points1[i]) * inv_sigma2;
-    if (chi2_in_1 > kChi2Mono) {
-      inlier = false;
-    } else {
-      out.score += kChi2Mono - chi2_in_1;
-    }
-    out.inliers[i] = inlier;
-    if (inlier) ++out.num_inliers;
-  }
+  score_both_ways(out, points1, points2, sigma_px, kChi2Mono,
+                  [&](const Vec2& a, const Vec2& b) { return transfer_error_squared(homography_21, a, b); },
+                  [&](const Vec2& b, const Vec2& a) { return transfer_error_squared(homography_12, b, a); });
   return out;
 }
 
@@ -261,26 +269,11 @@ ModelScore score_fundamental(const Mat3& fundamental_21, const std::vector<Vec2>
                              const std::vector<Vec2>& points2, double sigma_px) {
   ModelScore out;
   out.inliers.assign(points1.size(), false);
-  const double inv_sigma2 = 1.0 / (sigma_px * sigma_px);
   const Mat3 fundamental_12 = fundamental_21.transpose();
-  for (size_t i = 0; i < points1.size(); ++i) {
-    bool inlier = true;
-    // Same score per unit error as the homography (kChi2Mono), inlier threshold of a 1-DoF residual.
-    const double chi2_in_2 = line_distance_squared(fundamental_21, points1[i], points2[i]) * inv_sigma2;
-    if (chi2_in_2 > kChi2OneDof) {
-      inlier = false;
-    } else {
-      out.score += kChi2Mono - chi2_in_2;
-    }
-    const double chi2_in_1 = line_distance_squared(fundamental_12, points2[i], points1[i]) * inv_sigma2;
-    if (chi2_in_1 > kChi2OneDof) {
-      inlier = false;
-    } else {
-      out.score += kChi2Mono - chi2_in_1;
-    }
-    out.inliers[i] = inlier;
-    if (inlier) ++out.num_inliers;
-  }
+  // Same score per unit error as the homography (kChi2Mono), inlier threshold of a 1-DoF residual.
+  score_both_ways(out, points1, points2, sigma_px, kChi2OneDof,
+                  [&](const Vec2& a, const Vec2& b) { return line_distance_squared(fundamental_21, a, b); },
+                  [&](const Vec2& b, const Vec2& a) { return line_distance_squared(fundamental_12, b, a); });
   return out;
 }
 
