@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "crowdslam/io/image_check.h"
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::io {
@@ -42,10 +43,34 @@ const Trajectory& FrameSource::ground_truth() const {
 
 Dataset::Dataset(DatasetContents contents) : contents_(std::move(contents)) {}
 
+std::optional<cv::Size> Dataset::reference_size(std::size_t index, const cv::Mat& colour) const {
+  std::lock_guard<std::mutex> lock(reference_mutex_);
+  if (!reference_known_) {
+    if (index == 0) {
+      reference_size_ = colour.size();
+    } else {
+      try {
+        reference_size_ = read_colour_image(contents_.frames.front().colour_path).size();
+      } catch (const InputError&) {  // reported when frame 0 itself is loaded
+        reference_size_.reset();
+      }
+    }
+    reference_known_ = true;
+  }
+  return reference_size_;
+}
+
 FrameImages Dataset::load(std::size_t index) const {
   const FrameInfo& info = frame_info(index);
   FrameImages images;
   images.colour = read_colour_image(info.colour_path);
+  if (const auto expected = reference_size(index, images.colour); expected && images.colour.size() != *expected) {
+    const auto text = [](const cv::Size& s) { return std::to_string(s.width) + "x" + std::to_string(s.height); };
+    throw input_error(clipped(info.colour_path),
+                      "colour image is " + text(images.colour.size()) + ", but the first frame's (" +
+                          clipped(contents_.frames.front().colour_path) + ") is " + text(*expected) +
+                          "; every frame of a sequence must have the same size");
+  }
   if (!info.depth_path.empty()) {
     images.depth = read_depth_image(info.depth_path);
     check_same_size(images.depth, images.colour.size(), info.depth_path, "depth image");
@@ -85,7 +110,8 @@ SourceSummary Dataset::summary() const {
 
 std::string Dataset::default_settings_path() const {
   const auto candidate = std::filesystem::path(contents_.directory) / "settings.yaml";
-  return std::filesystem::is_regular_file(candidate) ? candidate.string() : std::string();
+  std::error_code ec;
+  return std::filesystem::is_regular_file(candidate, ec) ? candidate.string() : std::string();
 }
 
 }  // namespace crowdslam::io

@@ -13,13 +13,21 @@
 // Layout-specific calibration is on the derived classes (EurocDataset, KittiDataset in their headers).
 //
 // Errors: missing or malformed inputs throw crowdslam::InputError naming the file (and the line for list
-// files). Opening a dataset parses every list and checks that every listed image file exists; load(i)
-// additionally checks the image is complete (JPEG/PNG end markers), decodable, that depth is 16-bit and
-// that depth / right images have the colour image's size.
+// files). Opening a dataset parses every list and checks that every listed image file exists (a path
+// that cannot be checked, e.g. too long or a symlink loop, is "LIST:LINE: PATH: reason"); load(i)
+// additionally decodes the images strictly (image_check.h: truncated or corrupt JPEG/PNG are errors),
+// checks that depth is 16-bit, that the colour image has the size of the first frame's colour image
+// (the message names the colour file and both sizes), and that depth / right images have the colour
+// image's size. Paths and list lines quoted in messages are clipped (input_text.h).
+//
+// Nothing is dropped silently: entries a reader skips (duplicated time stamps, EuRoC left images without
+// a right image) are counted and warned about once (spdlog::warn) with the first LIST:LINE; see the
+// layout headers for what each layout skips.
 //
 // Depth is kept raw (CV_16UC1 as stored); Settings::depth_map_factor converts it to metres.
 #include <cstddef>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -122,7 +130,9 @@ class Dataset : public FrameSource {
   [[nodiscard]] std::size_t size() const { return contents_.frames.size(); }
   [[nodiscard]] const FrameInfo& frame_info(std::size_t index) const { return contents_.frames.at(index); }
   [[nodiscard]] const std::vector<FrameInfo>& frames() const { return contents_.frames; }
-  // Reads and validates frame `index` (see the header comment). Thread-safe (no shared state).
+  // Reads and validates frame `index` (see the header comment). Thread-safe. The colour size of frame 0
+  // is the reference every other frame is checked against (read once, when frame 0 is loaded or, for
+  // random access, when first needed).
   [[nodiscard]] FrameImages load(std::size_t index) const;
 
   std::optional<Frame> next() override;
@@ -133,8 +143,14 @@ class Dataset : public FrameSource {
   [[nodiscard]] std::string default_settings_path() const override;
 
  private:
+  // Size of frame 0's colour image, or nullopt when it cannot be read (no check then).
+  [[nodiscard]] std::optional<cv::Size> reference_size(std::size_t index, const cv::Mat& colour) const;
+
   DatasetContents contents_;
   std::size_t cursor_ = 0;
+  mutable std::mutex reference_mutex_;
+  mutable std::optional<cv::Size> reference_size_;
+  mutable bool reference_known_ = false;  // reference_size_ was determined (possibly as unreadable)
 };
 
 // Directory layouts, detected from the files present (see the layout headers):
@@ -143,7 +159,9 @@ class Dataset : public FrameSource {
 // Throws InputError naming `directory` when it is missing or no layout matches.
 std::unique_ptr<Dataset> open_dataset(const std::string& directory, const DatasetOptions& options = {});
 
-// A directory (open_dataset), a video file, or a camera index ("0"). Throws InputError naming `spec`.
+// A directory (open_dataset), a video file, or a camera index ("0"). Throws InputError naming `spec`;
+// a list or other text file (DIR/rgb.txt, data.csv, settings.yaml, *.json, ...) is refused with a
+// message saying so and asking for the dataset directory (its parent) instead of being opened as a video.
 std::unique_ptr<FrameSource> open_source(const std::string& spec, const DatasetOptions& options = {});
 
 }  // namespace crowdslam::io

@@ -8,7 +8,8 @@ namespace crowdslam::io {
 namespace {
 
 void require_file(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw input_error(path, "ground-truth file does not exist");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw input_error(path, "ground-truth file does not exist");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "crowdslam/io/euroc_dataset.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -7,15 +9,21 @@
 
 #include "crowdslam/io/dataset_ground_truth.h"
 #include "crowdslam/io/dataset_list.h"
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::io {
 namespace fs = std::filesystem;
 namespace {
 
+bool regular_file_exists(const fs::path& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
 fs::path mav0_of(const std::string& directory) {
   const fs::path dir(directory);
-  if (fs::is_regular_file(dir / "mav0" / "cam0" / "data.csv")) return dir / "mav0";
+  if (regular_file_exists(dir / "mav0" / "cam0" / "data.csv")) return dir / "mav0";
   return dir;
 }
 
@@ -52,24 +60,50 @@ EurocCameraCalibration parse_calibration(const cv::FileStorage& fs, const std::s
   return c;
 }
 
-// Full paths of a camera's list, checking each file exists; keyed by ns stamp.
+// Full paths of a camera's list, checking each file exists; keyed by ns stamp (of duplicated stamps the
+// later row wins, warned once).
 std::map<long long, ListEntry> camera_entries(const fs::path& cam_dir, std::size_t& count) {
   const std::string list = (cam_dir / "data.csv").string();
-  std::map<long long, ListEntry> entries;
-  const auto rows = read_euroc_list(list);
+  auto rows = read_euroc_list(list);
   count = rows.size();
-  for (auto row : rows) {
+  for (auto& row : rows) {
     row.file = (cam_dir / "data" / row.file).string();
     require_listed_file(row.file, list, row.line);
-    entries[row.timestamp_ns] = row;
   }
+  std::map<long long, ListEntry> entries;
+  for (auto& row : without_duplicate_stamps(rows, list, true)) entries.emplace(row.timestamp_ns, std::move(row));
   return entries;
+}
+
+// Left images without a right image of the same stamp are skipped: counted and warned once, with the
+// first such cam0 row (and the right-only count).
+void warn_unpaired(const std::map<long long, ListEntry>& left, const std::map<long long, ListEntry>& right,
+                   const fs::path& mav0) {
+  std::size_t left_only = 0;
+  int first_line = 0;
+  for (const auto& [ns, entry] : left) {
+    if (right.count(ns)) continue;
+    if (left_only++ == 0) first_line = entry.line;
+  }
+  std::size_t right_only = 0;
+  for (const auto& [ns, entry] : right) right_only += left.count(ns) ? 0 : 1;
+  if (left_only == 0 && right_only == 0) return;
+  const std::string left_list = clipped((mav0 / "cam0" / "data.csv").string());
+  const std::string right_list = clipped((mav0 / "cam1" / "data.csv").string());
+  if (left_only > 0) {
+    spdlog::warn("{}:{}: {} of {} left images have no right image with the same time stamp in {} (and {} right "
+                 "images no left one); stereo skips them",
+                 left_list, first_line, left_only, left.size(), right_list, right_only);
+  } else {
+    spdlog::warn("{}: {} of {} right images have no left image with the same time stamp in {}; they are skipped",
+                 right_list, right_only, right.size(), left_list);
+  }
 }
 
 }  // namespace
 
 EurocCameraCalibration read_euroc_camera_calibration(const std::string& sensor_yaml) {
-  if (!fs::is_regular_file(sensor_yaml)) throw input_error(sensor_yaml, "calibration file does not exist");
+  if (!regular_file_exists(sensor_yaml)) throw input_error(clipped(sensor_yaml), "calibration file does not exist");
   try {
     cv::FileStorage storage(sensor_yaml, cv::FileStorage::READ);
     if (!storage.isOpened()) throw input_error(sensor_yaml, "cannot open calibration file");
@@ -84,9 +118,7 @@ std::optional<geometry::Mat4> EurocDataset::right_from_left() const {
   return geometry::Mat4(right_->body_from_sensor.inverse() * left_.body_from_sensor);
 }
 
-bool looks_like_euroc(const std::string& directory) {
-  return fs::is_regular_file(mav0_of(directory) / "cam0" / "data.csv");
-}
+bool looks_like_euroc(const std::string& directory) { return regular_file_exists(mav0_of(directory) / "cam0" / "data.csv"); }
 
 std::unique_ptr<EurocDataset> open_euroc_dataset(const std::string& directory,
                                                  const DatasetOptions& options) {
@@ -98,7 +130,8 @@ std::unique_ptr<EurocDataset> open_euroc_dataset(const std::string& directory,
   const auto left = camera_entries(mav0 / "cam0", c.colour_entries);
   const auto left_calibration = read_euroc_camera_calibration((mav0 / "cam0" / "sensor.yaml").string());
   std::optional<EurocCameraCalibration> right_calibration;
-  if (fs::exists(mav0 / "cam1" / "data.csv")) {
+  std::error_code ec;
+  if (fs::exists(mav0 / "cam1" / "data.csv", ec)) {
     c.sensor = SensorKind::kStereo;
     const auto right = camera_entries(mav0 / "cam1", c.right_entries);
     right_calibration = read_euroc_camera_calibration((mav0 / "cam1" / "sensor.yaml").string());
@@ -108,14 +141,15 @@ std::unique_ptr<EurocDataset> open_euroc_dataset(const std::string& directory,
         c.frames.push_back({c.frames.size(), entry.timestamp_s, entry.file, {}, match->second.file});
     }
     if (c.frames.empty())
-      throw input_error((mav0 / "cam1" / "data.csv").string(), "no timestamp in common with cam0");
+      throw input_error(clipped((mav0 / "cam1" / "data.csv").string()), "no timestamp in common with cam0");
+    warn_unpaired(left, right, mav0);
   } else {
     c.sensor = SensorKind::kMonocular;
     for (const auto& [ns, entry] : left)
       c.frames.push_back({c.frames.size(), entry.timestamp_s, entry.file, {}, {}});
   }
   const auto gt = mav0 / "state_groundtruth_estimate0" / "data.csv";
-  if (fs::exists(gt)) {
+  if (fs::exists(gt, ec)) {
     c.ground_truth_path = gt.string();
     c.ground_truth = load_euroc_ground_truth(c.ground_truth_path);
   }

@@ -1,8 +1,11 @@
 #pragma once
 // EuRoC MAV layout: DIR/mav0/cam0/{data.csv,data/,sensor.yaml}, DIR/mav0/cam1/... (optional: without it
 // the sensor is monocular), DIR/mav0/state_groundtruth_estimate0/data.csv (optional). DIR may also be
-// the mav0 folder itself. Stereo frames are the cam0/cam1 rows with identical ns stamps. Images are the
-// raw (distorted, unrectified) ones; the parsed sensor.yaml calibration is exposed for rectification.
+// the mav0 folder itself. Stereo frames are the cam0/cam1 rows with identical ns stamps: left images
+// without a right one (e.g. a cam1 list shorter than cam0's) are skipped with one warning giving the
+// count and the first cam0 LINE; no common stamp at all is an error. Of rows with a duplicated ns stamp
+// the later is used (warned once). Images are the raw (distorted, unrectified) ones; the parsed
+// sensor.yaml calibration is exposed for rectification.
 #include <array>
 #include <memory>
 #include <optional>

@@ -1,95 +1,145 @@
 #include "crowdslam/io/image_check.h"
 
 #include <array>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
+#include "crowdslam/io/input_text.h"
+#include "crowdslam/io/jpeg_decode.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::io {
+namespace fs = std::filesystem;
 namespace {
 
 constexpr std::array<unsigned char, 8> kPngSignature{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-// Length 0, "IEND", CRC of "IEND".
-constexpr std::array<unsigned char, 12> kPngEnd{0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
+constexpr std::uintmax_t kMaxImageFileBytes = std::uintmax_t{1} << 30;
 
-std::vector<unsigned char> read_bytes(std::ifstream& in, std::streamoff offset, std::size_t count) {
-  std::vector<unsigned char> bytes(count);
-  in.seekg(offset);
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
-  if (!in) throw InputError("read error");
+// The whole file; InputError naming it when it cannot be read.
+std::vector<unsigned char> read_image_bytes(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) throw input_error(clipped(path), "image file does not exist");
+  if (ec) throw input_error(clipped(path), "cannot access image file: " + ec.message());
+  if (!fs::is_regular_file(status)) throw input_error(clipped(path), "image path is not a regular file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw input_error(clipped(path), "cannot read image file size: " + ec.message());
+  if (size == 0) throw input_error(clipped(path), "image file is empty");
+  if (size > kMaxImageFileBytes)
+    throw input_error(clipped(path), "image file of " + std::to_string(size) + " bytes is too large");
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) throw input_error(clipped(path), "cannot open image file");
+  const std::size_t read = std::fread(bytes.data(), 1, bytes.size(), file);
+  std::fclose(file);
+  if (read != bytes.size()) throw input_error(clipped(path), "read error (file changed while reading?)");
   return bytes;
 }
 
-// Last bytes of the file with trailing zero padding removed (some writers pad JPEGs to a block size).
-std::vector<unsigned char> tail_without_padding(std::ifstream& in, std::uintmax_t size) {
-  const std::size_t count = static_cast<std::size_t>(std::min<std::uintmax_t>(size, 4096));
-  auto tail = read_bytes(in, static_cast<std::streamoff>(size - count), count);
-  while (!tail.empty() && tail.back() == 0) tail.pop_back();
-  return tail;
+// CRC-32 (ISO-HDLC, as PNG and zlib), slice-by-8: about 1 ns/byte less than a byte-wise table.
+struct CrcTables {
+  std::uint32_t t[8][256];
+};
+
+const CrcTables& crc_tables() {
+  static const CrcTables tables = [] {
+    CrcTables c{};
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t crc = i;
+      for (int k = 0; k < 8; ++k) crc = (crc & 1) ? 0xEDB88320u ^ (crc >> 1) : crc >> 1;
+      c.t[0][i] = crc;
+    }
+    for (int k = 1; k < 8; ++k)
+      for (int i = 0; i < 256; ++i) c.t[k][i] = (c.t[k - 1][i] >> 8) ^ c.t[0][c.t[k - 1][i] & 0xFF];
+    return c;
+  }();
+  return tables;
 }
 
-void check_bytes(const std::string& path, std::uintmax_t size) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw input_error(path, "cannot open image file");
-  const std::size_t head_count = static_cast<std::size_t>(std::min<std::uintmax_t>(size, 8));
-  const auto head = read_bytes(in, 0, head_count);
-  const bool is_jpeg = head.size() >= 2 && head[0] == 0xFF && head[1] == 0xD8;
-  const bool is_png =
-      head.size() == 8 && std::equal(kPngSignature.begin(), kPngSignature.end(), head.begin());
-  if (is_jpeg) {
-    const auto tail = tail_without_padding(in, size);
-    if (tail.size() < 4 || tail[tail.size() - 2] != 0xFF || tail.back() != 0xD9)
-      throw input_error(path, "truncated JPEG image (no end-of-image marker FF D9)");
-  } else if (is_png) {
-    if (size < kPngSignature.size() + kPngEnd.size()) throw input_error(path, "truncated PNG image");
-    const auto tail = read_bytes(in, static_cast<std::streamoff>(size - kPngEnd.size()), kPngEnd.size());
-    if (!std::equal(kPngEnd.begin(), kPngEnd.end(), tail.begin()))
-      throw input_error(path, "truncated PNG image (does not end with the IEND chunk)");
+std::uint32_t load_le32(const unsigned char* p) {
+  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) |
+         (std::uint32_t{p[3]} << 24);
+}
+
+std::uint32_t load_be32(const unsigned char* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
+         std::uint32_t{p[3]};
+}
+
+std::uint32_t crc32(const unsigned char* p, std::size_t n) {
+  const auto& t = crc_tables().t;
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (; n >= 8; p += 8, n -= 8) {
+    const std::uint32_t one = crc ^ load_le32(p);
+    const std::uint32_t two = load_le32(p + 4);
+    crc = t[7][one & 0xFF] ^ t[6][(one >> 8) & 0xFF] ^ t[5][(one >> 16) & 0xFF] ^ t[4][one >> 24] ^
+          t[3][two & 0xFF] ^ t[2][(two >> 8) & 0xFF] ^ t[1][(two >> 16) & 0xFF] ^ t[0][two >> 24];
+  }
+  for (; n > 0; --n) crc = t[0][(crc ^ *p++) & 0xFF] ^ (crc >> 8);
+  return crc ^ 0xFFFFFFFFu;
+}
+
+bool is_chunk_type(const unsigned char* p) {
+  for (int i = 0; i < 4; ++i) {
+    const bool letter = (p[i] >= 'A' && p[i] <= 'Z') || (p[i] >= 'a' && p[i] <= 'z');
+    if (!letter) return false;
+  }
+  return true;
+}
+
+// Walks the chunks from IHDR to IEND checking lengths and CRCs (bytes after IEND are ignored).
+void check_png_chunks(const std::vector<unsigned char>& bytes, const std::string& path) {
+  std::size_t pos = kPngSignature.size();
+  bool first = true;
+  while (true) {
+    const std::string at = " at byte " + std::to_string(pos);
+    if (pos + 12 > bytes.size())
+      throw input_error(clipped(path), "truncated PNG image (ends" + at + " before the IEND chunk)");
+    const unsigned char* chunk = bytes.data() + pos;
+    const std::uint32_t length = load_be32(chunk);
+    if (length > 0x7FFFFFFFu || !is_chunk_type(chunk + 4))
+      throw input_error(clipped(path), "corrupt PNG image (bad chunk header" + at + ")");
+    const std::string type(reinterpret_cast<const char*>(chunk + 4), 4);
+    if (pos + 12 + length > bytes.size())
+      throw input_error(clipped(path), "truncated PNG image (chunk " + type + at + " is cut off)");
+    if (load_be32(chunk + 8 + length) != crc32(chunk + 4, 4 + length))
+      throw input_error(clipped(path), "corrupt PNG image (CRC error in chunk " + type + at + ")");
+    if (first && type != "IHDR") throw input_error(clipped(path), "corrupt PNG image (no IHDR chunk first)");
+    first = false;
+    if (type == "IEND") return;
+    pos += 12 + length;
   }
 }
 
 cv::Mat decode(const std::string& path, int flags) {
-  check_image_file_complete(path);
+  const std::vector<unsigned char> bytes = read_image_bytes(path);
+  if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) return decode_jpeg(bytes.data(), bytes.size(), path);
+  const bool is_png =
+      bytes.size() >= kPngSignature.size() && std::equal(kPngSignature.begin(), kPngSignature.end(), bytes.begin());
+  if (is_png) check_png_chunks(bytes, path);
   cv::Mat image;
   try {
-    image = cv::imread(path, flags);
+    image = cv::imdecode(bytes, flags);
   } catch (const cv::Exception& e) {
-    throw input_error(path, std::string("cannot decode image: ") + e.what());
+    throw input_error(clipped(path), std::string("cannot decode image: ") + e.what());
   }
-  if (image.empty()) throw input_error(path, "cannot decode image (unknown format or corrupt file)");
+  if (image.empty()) throw input_error(clipped(path), "cannot decode image (unknown format or corrupt file)");
   return image;
 }
 
 }  // namespace
-
-void check_image_file_complete(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw input_error(path, "image file does not exist");
-  if (!std::filesystem::is_regular_file(status)) throw input_error(path, "image path is not a regular file");
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw input_error(path, "cannot read image file size");
-  if (size == 0) throw input_error(path, "image file is empty");
-  try {
-    check_bytes(path, size);
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    if (message.rfind(path, 0) == 0) throw;
-    throw input_error(path, message);
-  }
-}
 
 cv::Mat read_colour_image(const std::string& path) { return decode(path, cv::IMREAD_ANYCOLOR); }
 
 cv::Mat read_depth_image(const std::string& path) {
   cv::Mat depth = decode(path, cv::IMREAD_UNCHANGED);
   if (depth.type() != CV_16UC1) {
-    throw input_error(path, "depth image must be 16-bit single-channel (got " +
-                                std::to_string(depth.channels()) + " channel(s) of " +
-                                std::to_string(8 * static_cast<int>(depth.elemSize1())) + "-bit)");
+    throw input_error(clipped(path), "depth image must be 16-bit single-channel (got " +
+                                         std::to_string(depth.channels()) + " channel(s) of " +
+                                         std::to_string(8 * static_cast<int>(depth.elemSize1())) + "-bit)");
   }
   return depth;
 }
@@ -97,9 +147,9 @@ cv::Mat read_depth_image(const std::string& path) {
 void check_same_size(const cv::Mat& image, const cv::Size& expected, const std::string& path,
                      const std::string& what) {
   if (image.size() == expected) return;
-  throw input_error(path, what + " is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                              ", expected " + std::to_string(expected.width) + "x" +
-                              std::to_string(expected.height));
+  throw input_error(clipped(path), what + " is " + std::to_string(image.cols) + "x" +
+                                       std::to_string(image.rows) + ", expected " +
+                                       std::to_string(expected.width) + "x" + std::to_string(expected.height));
 }
 
 }  // namespace crowdslam::io

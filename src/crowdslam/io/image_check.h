@@ -1,27 +1,32 @@
 #pragma once
 // Reading dataset images with validation: every failure is an InputError naming the file.
 //
-// cv::imread happily returns a partly grey image for a truncated JPEG, so before decoding we check the
-// file's end marker: a JPEG (starts FF D8) must end with FF D9 (trailing zero padding allowed), a PNG
-// must end with its IEND chunk. Other formats are only checked by decoding.
+// cv::imread happily returns a partly grey image for a truncated or corrupt JPEG (libjpeg only prints
+// a warning on stderr that names no file) and lets libpng print its complaints too. So:
+//   - JPEG (starts FF D8) is decoded with libjpeg directly (jpeg_decode.h): every libjpeg error or
+//     warning is an InputError naming the file and libjpeg's message. Bytes after the end-of-image
+//     marker are accepted (some writers pad files).
+//   - PNG: before decoding, the chunk structure is walked and every chunk's CRC checked; a file cut
+//     short (before IEND) or with a flipped bit is an error naming the file, and libpng never sees it.
+//   - Other formats are only checked by decoding (cv::imdecode).
+// Files are read into memory once; decoding does not touch the disk again.
 #include <opencv2/core.hpp>
 #include <string>
 
 namespace crowdslam::io {
 
-// Throws InputError naming `path` if the file is missing, empty, or a truncated JPEG/PNG.
-void check_image_file_complete(const std::string& path);
-
-// Colour or grey image as stored (8-bit BGR or 8-bit grey; 16-bit and alpha are reduced by OpenCV's
-// IMREAD_ANYCOLOR). Throws InputError naming `path` when missing, truncated or undecodable.
+// Colour or grey image as stored (8-bit BGR or 8-bit grey; 16-bit and alpha are reduced as OpenCV's
+// IMREAD_ANYCOLOR does; EXIF orientation applied as cv::imread does). Same pixels as
+// cv::imread(path, cv::IMREAD_ANYCOLOR) for a valid file. Throws InputError naming `path` when it is
+// missing, not a regular file, empty, truncated, corrupt or undecodable.
 cv::Mat read_colour_image(const std::string& path);
 
 // Raw 16-bit single-channel depth (values as stored, metres = value / DepthMapFactor). Throws InputError
 // naming `path` for any other type (e.g. an 8-bit depth image) or when missing/truncated/undecodable.
 cv::Mat read_depth_image(const std::string& path);
 
-// Throws InputError naming `path` unless `image` has the size `expected` ("depth" / "right image" names
-// what is being compared in the message).
+// Throws InputError naming `path` unless `image` has the size `expected` ("depth image" / "right image"
+// names what is being compared in the message).
 void check_same_size(const cv::Mat& image, const cv::Size& expected, const std::string& path,
                      const std::string& what);
 

@@ -7,6 +7,7 @@
 
 #include "crowdslam/io/dataset_ground_truth.h"
 #include "crowdslam/io/dataset_list.h"
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 
@@ -29,7 +30,7 @@ std::map<std::string, std::vector<double>> read_projections(const std::string& p
     const int line = static_cast<int>(i + 1);
     const auto fields = split_fields(lines[i], false);
     if (fields[0].empty() || fields[0].back() != ':')
-      throw input_error(path, line, "expected 'NAME: numbers'");
+      throw input_error(clipped(path), line, "expected 'NAME: numbers', got '" + clipped(trim(lines[i])) + "'");
     const std::string name = fields[0].substr(0, fields[0].size() - 1);
     if (name.size() != 2 || name[0] != 'P') continue;  // Tr:, etc. are not needed
     if (fields.size() != 13)
@@ -38,7 +39,7 @@ std::map<std::string, std::vector<double>> read_projections(const std::string& p
     for (std::size_t k = 1; k < fields.size(); ++k) {
       const auto v = parse_double(fields[k]);
       if (!v || !std::isfinite(*v))
-        throw input_error(path, line, name + ": '" + fields[k] + "' is not a finite number");
+        throw input_error(clipped(path), line, name + ": '" + clipped(fields[k]) + "' is not a finite number");
       values.push_back(*v);
     }
     projections[name] = values;
@@ -46,20 +47,33 @@ std::map<std::string, std::vector<double>> read_projections(const std::string& p
   return projections;
 }
 
+bool regular_file_exists(const fs::path& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
+bool directory_exists(const fs::path& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
 fs::path ground_truth_path(const fs::path& dir) {
-  const fs::path normal = fs::absolute(dir).lexically_normal();
-  const fs::path sequence = normal.has_filename() ? normal : normal.parent_path();
-  const fs::path official =
-      sequence.parent_path().parent_path() / "poses" / (sequence.filename().string() + ".txt");
-  if (fs::is_regular_file(official)) return official;
-  if (fs::is_regular_file(dir / "poses.txt")) return dir / "poses.txt";
+  std::error_code ec;
+  const fs::path normal = fs::absolute(dir, ec).lexically_normal();
+  if (!ec) {
+    const fs::path sequence = normal.has_filename() ? normal : normal.parent_path();
+    const fs::path official =
+        sequence.parent_path().parent_path() / "poses" / (sequence.filename().string() + ".txt");
+    if (regular_file_exists(official)) return official;
+  }
+  if (regular_file_exists(dir / "poses.txt")) return dir / "poses.txt";
   return {};
 }
 
 }  // namespace
 
 KittiCalibration read_kitti_calibration(const std::string& calib_txt) {
-  if (!fs::is_regular_file(calib_txt)) throw input_error(calib_txt, "calibration file does not exist");
+  if (!regular_file_exists(calib_txt)) throw input_error(clipped(calib_txt), "calibration file does not exist");
   const auto projections = read_projections(calib_txt);
   const auto p0 = projections.find("P0");
   if (p0 == projections.end()) throw input_error(calib_txt, "no P0 line");
@@ -75,7 +89,7 @@ KittiCalibration read_kitti_calibration(const std::string& calib_txt) {
 
 bool looks_like_kitti(const std::string& directory) {
   const fs::path dir(directory);
-  return fs::is_regular_file(dir / "times.txt") && fs::is_directory(dir / "image_0");
+  return regular_file_exists(dir / "times.txt") && directory_exists(dir / "image_0");
 }
 
 std::unique_ptr<KittiDataset> open_kitti_dataset(const std::string& directory,
@@ -89,7 +103,7 @@ std::unique_ptr<KittiDataset> open_kitti_dataset(const std::string& directory,
   const auto entries = read_times_list(times);
   std::vector<double> stamps;
   for (const auto& e : entries) stamps.push_back(e.timestamp_s);
-  const bool stereo = fs::is_directory(dir / "image_1");
+  const bool stereo = directory_exists(dir / "image_1");
   c.sensor = stereo ? SensorKind::kStereo : SensorKind::kMonocular;
   const auto calibration = read_kitti_calibration((dir / "calib.txt").string());
   if (stereo && calibration.bf <= 0)

@@ -3,13 +3,15 @@
 #include <cmath>
 #include <filesystem>
 
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::io {
 
 std::unique_ptr<VideoSource> VideoSource::open_file(const std::string& path, const DatasetOptions& options) {
   options.check();
-  if (!std::filesystem::is_regular_file(path)) throw input_error(path, "video file does not exist");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw input_error(clipped(path), "video file does not exist");
   std::unique_ptr<VideoSource> source(new VideoSource(path, false));
   try {
     // FFmpeg handles nearly every file; OpenCV's own MJPEG reader and image-sequence patterns
