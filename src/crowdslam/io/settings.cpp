@@ -125,6 +125,8 @@ Settings load_settings(const std::string& path, SensorKind sensor) {
   } else {
     set_if(r.real("DepthMapFactor"), s.depth_map_factor);
   }
+  s.has_depth_map_factor = r.has("DepthMapFactor");
+  s.has_baseline = r.has("Camera.bf");
   s.orb = read_orb(r);
   s.rectification = read_rectification(r);
   read_own_sections(r, s);
@@ -158,7 +160,8 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.feature_budget.factors == b.feature_budget.factors &&
                       a.feature_budget.area == b.feature_budget.area;
   return camera && orb && detector && people && budget && a.th_depth == b.th_depth &&
-         a.depth_map_factor == b.depth_map_factor &&
+         a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&
+         a.has_baseline == b.has_baseline &&
          a.output.trajectory_format == b.output.trajectory_format &&
          same_rectification(a.rectification, b.rectification);
 }

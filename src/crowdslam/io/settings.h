@@ -10,7 +10,13 @@
 // those are the rectified images, so Camera.fx/fy/cx/cy must match LEFT.P and Camera.bf must match
 // -RIGHT.P(0,3) (checked, 0.1% tolerance).
 //
-// Every missing or invalid value throws InputError "FILE: KEY: reason".
+// Every missing or invalid value throws InputError "FILE: KEY: reason". A key set twice is an error
+// "FILE:LINE: KEY: set twice (first on line N)"; an unknown key is a warning naming FILE:LINE and the key,
+// with the closest known key as a suggestion; ORB-SLAM2/3 keys crowdslam does not use (Viewer.*,
+// Camera.type, Camera.bFishEye, IMU.*, System.*, File.version, Tbc) are accepted silently (see
+// settings_reader.h). Integers must fit in 32 bits ("ORBextractor.nFeatures: 1e20 is out of range for an
+// integer"), and every value is checked against what the components that use it accept (FAST thresholds
+// 1..254, at most 100000 features, ...), so no component rejects a value without naming file and key.
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -97,10 +103,22 @@ struct Settings {
   PeopleFilterSettings people_filter;
   FeatureBudgetSettings feature_budget;
   OutputSettings output;
+  // Which camera the file describes, whatever sensor it was loaded for: DepthMapFactor present = an
+  // RGB-D camera; Camera.bf present = a camera with a baseline (stereo, or RGB-D's virtual baseline: a
+  // stereo file has Camera.bf without DepthMapFactor). write_settings writes DepthMapFactor / Camera.bf
+  // only when these are set. Part of operator==.
+  bool has_depth_map_factor = false;
+  bool has_baseline = false;
 
   // Validates every value for the sensor; throws InputError "PATH: KEY: reason".
   void check(SensorKind sensor) const;
 };
+
+// Throws InputError "IMAGE: image is WxH, but the settings FILE give Camera.width/height W0xH0" when
+// the settings give both Camera.width and Camera.height and `image` differs. When they do not (0 = not
+// given), nothing is checked here: the dataset then checks every frame against its first one
+// (Dataset::load).
+void check_image_size(const Settings& settings, cv::Size image, const std::string& image_path);
 
 bool operator==(const Settings& a, const Settings& b);
 inline bool operator!=(const Settings& a, const Settings& b) { return !(a == b); }
@@ -109,8 +127,9 @@ inline bool operator!=(const Settings& a, const Settings& b) { return !(a == b);
 // DepthMapFactor) are enforced for that sensor.
 Settings load_settings(const std::string& path, SensorKind sensor);
 
-// Writes every key (ORB-SLAM2 names, our sections, rectification when present) atomically; numbers with
-// 17 significant digits, so load_settings(path, sensor) == settings. Checks nothing.
+// Writes every key (ORB-SLAM2 names, our sections, rectification when present; DepthMapFactor and
+// Camera.bf as has_depth_map_factor / has_baseline say) atomically; numbers with 17 significant digits,
+// so load_settings(path, sensor) == settings. Checks nothing.
 void write_settings(const std::string& path, const Settings& settings);
 
 }  // namespace crowdslam::io

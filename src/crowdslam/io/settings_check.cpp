@@ -2,6 +2,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/io/settings.h"
 #include "crowdslam/util/error.h"
 
@@ -9,10 +10,19 @@ namespace crowdslam::io {
 namespace {
 
 constexpr double kConsistencyTolerance = 1e-3;  // relative, Camera.* vs LEFT.P / RIGHT.P
+// Bounds of what the components accept (feature::ORBExtractor, the feature budget, the detector's
+// network input, the tracker's keyframe interval), so a value is reported here with file and key.
+constexpr int kMaxImageSide = 65535;
+constexpr int kMaxFeatures = 100000;
+constexpr int kMaxFastThreshold = 254;
+constexpr double kMaxScaleFactor = 4.0;
+constexpr double kMaxFps = 10000.0;
+constexpr int kMaxDetectorInput = 2048;
+constexpr double kMaxBudgetFactor = 10.0;
 
 class Checker {
  public:
-  explicit Checker(const std::string& path) : path_(path.empty() ? std::string("settings") : path) {}
+  explicit Checker(const std::string& path) : path_(path.empty() ? std::string("settings") : clipped(path)) {}
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
     throw input_error(path_, key + ": " + reason);
@@ -56,6 +66,8 @@ void check_camera(const Checker& c, const CameraSettings& cam, SensorKind sensor
     c.finite(value, key);
   c.require(cam.width >= 0, "Camera.width", ">= 0", cam.width);
   c.require(cam.height >= 0, "Camera.height", ">= 0", cam.height);
+  c.require(cam.width <= kMaxImageSide, "Camera.width", "<= 65535", cam.width);
+  c.require(cam.height <= kMaxImageSide, "Camera.height", "<= 65535", cam.height);
   const std::string cx_rule =
       cam.width > 0 ? "in (0, Camera.width=" + std::to_string(cam.width) + ")" : "> 0";
   const std::string cy_rule =
@@ -65,6 +77,7 @@ void check_camera(const Checker& c, const CameraSettings& cam, SensorKind sensor
   c.require(std::isfinite(cam.cy) && cam.cy > 0 && (cam.height == 0 || cam.cy < cam.height), "Camera.cy",
             cy_rule, cam.cy);
   c.positive(cam.fps, "Camera.fps");
+  c.require(cam.fps <= kMaxFps, "Camera.fps", "<= 10000", cam.fps);
   if (sensor != SensorKind::kMonocular) {
     c.positive(cam.bf, "Camera.bf");
   } else {
@@ -74,17 +87,22 @@ void check_camera(const Checker& c, const CameraSettings& cam, SensorKind sensor
 
 void check_orb(const Checker& c, const OrbSettings& o) {
   c.require(o.n_features > 0, "ORBextractor.nFeatures", "> 0", o.n_features);
-  c.require(std::isfinite(o.scale_factor) && o.scale_factor > 1.0, "ORBextractor.scaleFactor", "> 1",
-            o.scale_factor);
+  c.require(o.n_features <= kMaxFeatures, "ORBextractor.nFeatures", "<= 100000", o.n_features);
+  // As a float (the extractor's type) too: 1.00000001 would become 1.
+  c.require(std::isfinite(o.scale_factor) && o.scale_factor > 1.0 && static_cast<float>(o.scale_factor) > 1.f,
+            "ORBextractor.scaleFactor", "> 1", o.scale_factor);
+  c.require(o.scale_factor <= kMaxScaleFactor, "ORBextractor.scaleFactor", "<= 4", o.scale_factor);
   c.require(o.n_levels >= 1 && o.n_levels <= 20, "ORBextractor.nLevels", "in 1..20", o.n_levels);
   c.require(o.min_th_fast > 0, "ORBextractor.minThFAST", "> 0", o.min_th_fast);
   c.require(o.ini_th_fast >= o.min_th_fast, "ORBextractor.iniThFAST", ">= ORBextractor.minThFAST",
             o.ini_th_fast);
+  c.require(o.ini_th_fast <= kMaxFastThreshold, "ORBextractor.iniThFAST",
+            "<= 254 (a FAST threshold on 8-bit intensities)", o.ini_th_fast);
 }
 
 void check_side(const Checker& c, const RectificationSide& s, const std::string& side) {
-  c.require(s.width > 0, side + ".width", "> 0", s.width);
-  c.require(s.height > 0, side + ".height", "> 0", s.height);
+  c.require(s.width > 0 && s.width <= kMaxImageSide, side + ".width", "in 1..65535", s.width);
+  c.require(s.height > 0 && s.height <= kMaxImageSide, side + ".height", "in 1..65535", s.height);
   auto shape = [&](const cv::Mat& m, int rows, int cols, const std::string& key) {
     if (m.rows != rows || m.cols != cols)
       c.fail(key, "must be " + std::to_string(rows) + "x" + std::to_string(cols) + ", got " +
@@ -120,6 +138,7 @@ void check_own_sections(const Checker& c, const Settings& s) {
   const auto& d = s.detector;
   c.require(d.input_size > 0 && d.input_size % 32 == 0, "Detector.input_size", "a positive multiple of 32",
             d.input_size);
+  c.require(d.input_size <= kMaxDetectorInput, "Detector.input_size", "<= 2048", d.input_size);
   c.require(std::isfinite(d.confidence) && d.confidence > 0 && d.confidence <= 1, "Detector.confidence",
             "in (0, 1]", d.confidence);
   c.require(std::isfinite(d.nms) && d.nms > 0 && d.nms <= 1, "Detector.nms", "in (0, 1]", d.nms);
@@ -145,7 +164,10 @@ void check_own_sections(const Checker& c, const Settings& s) {
     c.fail("FeatureBudget.factors", "must have one more entry than FeatureBudget.thresholds (" +
                                         std::to_string(b.thresholds.size() + 1) + "), got " +
                                         std::to_string(b.factors.size()));
-  for (const double f : b.factors) c.positive(f, "FeatureBudget.factors");
+  for (const double f : b.factors) {
+    c.positive(f, "FeatureBudget.factors");
+    c.require(f <= kMaxBudgetFactor, "FeatureBudget.factors", "<= 10", f);
+  }
   c.require(b.area == "sum" || b.area == "union", "FeatureBudget.area", "\"sum\" or \"union\"",
             "\"" + b.area + "\"");
   const auto& format = s.output.trajectory_format;
@@ -153,7 +175,19 @@ void check_own_sections(const Checker& c, const Settings& s) {
             "\"tum\", \"kitti\" or \"euroc\"", "\"" + format + "\"");
 }
 
+std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
+
 }  // namespace
+
+void check_image_size(const Settings& settings, cv::Size image, const std::string& image_path) {
+  const auto& cam = settings.camera;
+  if (cam.width <= 0 || cam.height <= 0) return;
+  if (image.width == cam.width && image.height == cam.height) return;
+  const std::string file = settings.path.empty() ? std::string("settings") : clipped(settings.path);
+  throw input_error(clipped(image_path), "image is " + size_text(image.width, image.height) + ", but the settings " +
+                                             file + " give Camera.width/height " + size_text(cam.width, cam.height) +
+                                             " (settings for another camera?)");
+}
 
 void Settings::check(SensorKind sensor) const {
   const Checker c(path);

@@ -63,12 +63,15 @@ void write_camera(std::ostream& out, const Settings& s) {
       << "\nCamera.k3: " << real_text(c.k3) << "\n\n";
   if (c.width > 0) out << "Camera.width: " << c.width << "\n";
   if (c.height > 0) out << "Camera.height: " << c.height << "\n";
-  out << "Camera.fps: " << real_text(c.fps) << "\nCamera.bf: " << real_text(c.bf) << "\n";
+  out << "Camera.fps: " << real_text(c.fps) << "\n";
+  if (s.has_baseline) out << "Camera.bf: " << real_text(c.bf) << "\n";
   out << "# Colour order of the images (0: BGR, 1: RGB; ignored for grey images)\nCamera.RGB: "
       << (c.rgb ? 1 : 0) << "\n\n";
   out << "# Close/far threshold (baseline multiples)\nThDepth: " << real_text(s.th_depth) << "\n";
-  out << "# Depth map values factor (raw / factor = metres)\nDepthMapFactor: "
-      << real_text(s.depth_map_factor) << "\n\n";
+  if (s.has_depth_map_factor)
+    out << "# Depth map values factor (raw / factor = metres)\nDepthMapFactor: " << real_text(s.depth_map_factor)
+        << "\n";
+  out << "\n";
 }
 
 void write_orb(std::ostream& out, const OrbSettings& o) {
