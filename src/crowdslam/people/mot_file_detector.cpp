@@ -1,7 +1,5 @@
 #include "crowdslam/people/mot_file_detector.h"
 
-#include <spdlog/spdlog.h>
-
 #include <chrono>
 
 #include "crowdslam/people/mot_format.h"
@@ -11,9 +9,7 @@ namespace crowdslam::people {
 MotFileDetector::MotFileDetector(const std::string& path, const DetectorOptions& options) : path_(path) {
   options.check();
   const MotFile file = read_mot_file(path);
-  dropped_empty_ = file.dropped_empty;
-  if (dropped_empty_ > 0)
-    spdlog::warn("{}: dropped {} boxes with zero or negative size", path, dropped_empty_);
+  dropped_empty_ = file.dropped_empty;  // read_mot_file warned about the skipped rows
   for (const MotRow& row : file.rows) {
     if (row.score < options.confidence) continue;
     boxes_by_frame_[row.frame].push_back({row.box, static_cast<float>(row.score)});

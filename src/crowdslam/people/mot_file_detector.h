@@ -6,8 +6,9 @@
 //   frame_index + 1. Frames absent from the file (including every frame after the file's last one, when
 //   the file is shorter than the sequence) have no boxes.
 // - Rows with conf < DetectorOptions::confidence are dropped (files without a 7th column count as 1).
-// - Boxes are clipped to the image given to detect(); boxes with zero or negative size, or nothing left
-//   after clipping, are dropped.
+// - Boxes are clipped to the image given to detect(); boxes with zero or negative size or beyond
+//   kMaxBoxCoordinate are skipped when the file is read (counted and warned once, mot_format.h), and
+//   boxes with nothing left after clipping are dropped.
 // - NaN / infinite / non-numeric fields make the constructor throw InputError "FILE:LINE: ..." (a broken
 //   file is reported before any frame is processed; never a crash).
 // - Boxes are used as given: `boxes` and `raw` are the same (no NMS; the external detector did that).

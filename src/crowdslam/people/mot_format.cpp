@@ -1,8 +1,11 @@
 #include "crowdslam/people/mot_format.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <sstream>
 
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
@@ -14,9 +17,9 @@ double number(const std::string& path, int line, const std::vector<std::string>&
               bool finite) {
   const auto value = parse_double(fields[i]);
   if (!value)
-    throw input_error(path, line, "field " + std::to_string(i + 1) + " is not a number: '" + fields[i] + "'");
+    throw input_error(path, line, "field " + std::to_string(i + 1) + " is not a number: '" + io::clipped(fields[i]) + "'");
   if (finite && !std::isfinite(*value))
-    throw input_error(path, line, "field " + std::to_string(i + 1) + " is not finite: '" + fields[i] + "'");
+    throw input_error(path, line, "field " + std::to_string(i + 1) + " is not finite: '" + io::clipped(fields[i]) + "'");
   return *value;
 }
 
@@ -30,9 +33,12 @@ MotRow parse_row(const std::string& path, int line, const std::vector<std::strin
   row.line = line;
   const double frame = number(path, line, f, 0, true);
   if (frame < 1 || frame != std::floor(frame) || frame > 1e9)
-    throw input_error(path, line, "frame must be an integer >= 1, got '" + f[0] + "'");
+    throw input_error(path, line, "frame must be an integer >= 1, got '" + io::clipped(f[0]) + "'");
   row.frame = static_cast<int>(frame);
-  row.id = static_cast<int>(number(path, line, f, 1, true));
+  const double id = number(path, line, f, 1, true);
+  if (id != std::floor(id) || std::abs(id) > 2e9)
+    throw input_error(path, line, "id must be an integer, got '" + io::clipped(f[1]) + "'");
+  row.id = static_cast<int>(id);
   row.box = cv::Rect2f(
       static_cast<float>(number(path, line, f, 2, true)), static_cast<float>(number(path, line, f, 3, true)),
       static_cast<float>(number(path, line, f, 4, true)), static_cast<float>(number(path, line, f, 5, true)));
@@ -42,10 +48,10 @@ MotRow parse_row(const std::string& path, int line, const std::vector<std::strin
     const double vis = number(path, line, f, 8, true);
     if (cls != std::floor(cls) || cls < -1)
       throw input_error(path, line,
-                        "9-column ground truth: class (field 8) must be an integer, got '" + f[7] + "'");
+                        "9-column ground truth: class (field 8) must be an integer, got '" + io::clipped(f[7]) + "'");
     if (vis < 0 || vis > 1)
       throw input_error(path, line,
-                        "9-column ground truth: visibility (field 9) must be in [0, 1], got '" + f[8] + "'");
+                        "9-column ground truth: visibility (field 9) must be in [0, 1], got '" + io::clipped(f[8]) + "'");
     row.object_class = static_cast<int>(cls);
     row.visibility = vis;
   }
@@ -72,12 +78,22 @@ MotFile read_mot_file(const std::string& path, bool ground_truth) {
                         "expected " + std::to_string(file.columns) + " fields like the first row, got " +
                             std::to_string(fields.size()));
     MotRow row = parse_row(path, line, fields, ground_truth && file.columns == 9);
-    if (!(row.box.width > 0 && row.box.height > 0)) {
-      ++file.dropped_empty;
+    const bool empty = !(row.box.width > 0 && row.box.height > 0);
+    const bool out_of_range = std::abs(row.box.x) > kMaxBoxCoordinate || std::abs(row.box.y) > kMaxBoxCoordinate ||
+                              row.box.width > kMaxBoxCoordinate || row.box.height > kMaxBoxCoordinate;
+    if (empty || out_of_range) {
+      ++(empty ? file.dropped_empty : file.dropped_out_of_range);
+      if (file.first_dropped_line == 0) file.first_dropped_line = line;
       continue;
     }
     file.rows.push_back(row);
   }
+  if (file.first_dropped_line > 0)
+    spdlog::warn("{}:{}: {} box{} skipped: {} with zero or negative width/height, {} with a coordinate or size beyond "
+                 "1e6 pixels",
+                 io::clipped(path), file.first_dropped_line, file.dropped_empty + file.dropped_out_of_range,
+                 file.dropped_empty + file.dropped_out_of_range == 1 ? "" : "es", file.dropped_empty,
+                 file.dropped_out_of_range);
   return file;
 }
 

@@ -7,7 +7,9 @@
 // Reading is strict: a line with fewer than 6 fields, a field that is not a number, or a NaN / infinite
 // value in any of the first 7 fields throws InputError "FILE:LINE: ..." (a broken file is reported, never
 // silently half-used). A frame number that is not an integer >= 1 is an error too. Boxes with zero or
-// negative width or height are NOT errors: readers drop them (and count them in `dropped_empty`).
+// negative width or height, or a coordinate or size beyond +-kMaxBoxCoordinate pixels, are NOT errors:
+// the reader skips them, counts them (`dropped_empty`, `dropped_out_of_range`) and warns once
+// (spdlog::warn) naming FILE:LINE of the first one and the counts.
 #include <cstddef>
 #include <opencv2/core.hpp>
 #include <string>
@@ -27,11 +29,16 @@ struct MotRow {
   int line = 0;              // 1-based line in the file
 };
 
+// Larger than any image side: a box beyond it is a broken row, not a person.
+constexpr double kMaxBoxCoordinate = 1e6;
+
 struct MotFile {
   std::string path;
-  std::size_t columns = 0;        // field count of the rows (all rows must agree)
-  std::vector<MotRow> rows;       // rows with a positive-size box, in file order
-  std::size_t dropped_empty = 0;  // rows dropped for zero / negative width or height
+  std::size_t columns = 0;               // field count of the rows (all rows must agree)
+  std::vector<MotRow> rows;              // rows with a positive-size box, in file order
+  std::size_t dropped_empty = 0;         // rows dropped for zero / negative width or height
+  std::size_t dropped_out_of_range = 0;  // rows dropped for |x|, |y|, w or h > kMaxBoxCoordinate
+  int first_dropped_line = 0;            // line of the first dropped row, 0 when none
 };
 
 // Reads a MOT file. `ground_truth` = parse columns 8-9 as class and visibility when the file has exactly

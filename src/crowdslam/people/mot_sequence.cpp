@@ -6,6 +6,7 @@
 #include <map>
 
 #include "crowdslam/io/image_folder_dataset.h"
+#include "crowdslam/io/input_text.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 
@@ -36,10 +37,15 @@ double positive_number(const std::string& path, const std::string& key, const st
 std::vector<std::string> sorted_images(const std::string& directory) {
   std::vector<std::string> files;
   std::error_code ec;
-  for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec))
-    if (it->is_regular_file() && io::is_image_file_name(it->path().filename().string()))
-      files.push_back(it->path().string());
-  if (ec) throw input_error(directory, "cannot list directory: " + ec.message());
+  for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec)) {
+    if (!io::is_image_file_name(it->path().filename().string())) continue;
+    std::error_code entry_ec;
+    const fs::file_status status = fs::status(it->path(), entry_ec);
+    if (entry_ec && status.type() != fs::file_type::not_found)
+      throw input_error(io::clipped(it->path().string()), "cannot read image entry: " + entry_ec.message());
+    if (fs::is_regular_file(status)) files.push_back(it->path().string());
+  }
+  if (ec) throw input_error(io::clipped(directory), "cannot list directory: " + ec.message());
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -73,7 +79,9 @@ std::unique_ptr<io::Dataset> open_mot_sequence(const std::string& directory) {
       std::snprintf(name, sizeof(name), "%06zu", i);
       const std::string file = (fs::path(im_dir) / (name + ext)).string();
       if (!fs::is_regular_file(file, ec))
-        throw input_error(file, "missing image (" + ini + " says seqLength=" + info["seqLength"] + ")");
+        throw input_error(io::clipped(file), (ec && ec != std::errc::no_such_file_or_directory ? ec.message() + ": " : "") +
+                                                 "missing image (" + io::clipped(ini) + " says seqLength=" +
+                                                 io::clipped(info["seqLength"]) + ")");
       files.push_back(file);
     }
   } else {
