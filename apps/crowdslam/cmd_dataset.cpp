@@ -116,7 +116,7 @@ void add_dataset_command(CLI::App& app, const GlobalOptions& global) {
       dataset->add_subcommand("info", "Layout, sensor, frame counts, ground truth, time span, image size");
   info->add_option("source", options->source, "Dataset directory, video file or camera index")->required();
   info->add_option("--fps", options->fps, "Frame rate for image folders / videos (default: file's or 30)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 10000.0));
   info->add_flag("--check", options->check,
                  "Read and validate every frame (end markers, decoding, depth type/size)");
   info->callback([options, &global] { run_info(*options, global); });

@@ -20,6 +20,11 @@
 namespace crowdslam::app {
 namespace {
 
+constexpr int kMaxInputSize = 2048;  // as Detector.input_size in the settings
+constexpr int kMaxPersonClass = 9999;
+constexpr int kMaxThreads = 64;
+constexpr std::size_t kMaxFrames = 1000000000;
+
 struct DetectArgs {
   std::string settings;
   std::string dataset;
@@ -171,16 +176,26 @@ void add_detect_command(CLI::App& app, const GlobalOptions& global) {
   detect
       ->add_option("--model", args->model, "body, coco, a Darknet .cfg (.weights beside it) or an .onnx file")
       ->capture_default_str();
+  // Every numeric option is bounded here, so a bad value is a clear CLI error (e.g. --threads 100000 used
+  // to make OpenCV start 100000 threads and crash at exit).
   detect->add_option("--input-size", args->options.input_size, "Network input size (multiple of 32)")
-      ->capture_default_str();
-  detect->add_option("--confidence", args->options.confidence, "Confidence threshold")->capture_default_str();
-  detect->add_option("--nms", args->options.nms, "NMS IoU threshold")->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(32, kMaxInputSize));
+  detect->add_option("--confidence", args->options.confidence, "Confidence threshold")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  detect->add_option("--nms", args->options.nms, "NMS IoU threshold")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   detect->add_option("--person-class", args->options.person_class, "Person class index")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0, kMaxPersonClass));
   detect->add_option("--threads", args->options.opencv_threads, "cv::setNumThreads for OpenCV (0 = leave)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0, kMaxThreads));
   detect->add_flag("--raw", args->raw, "Write every box above the threshold before NMS");
-  detect->add_option("--max-frames", args->max_frames, "Stop after this many frames (0 = all)");
+  detect->add_option("--max-frames", args->max_frames, "Stop after this many frames (0 = all)")
+      ->check(CLI::Range(std::size_t{0}, kMaxFrames));
   detect->callback([args, &global] { run_detect(*args, global); });
 
   auto eval_args = std::make_shared<DetectEvalArgs>();
@@ -189,10 +204,12 @@ void add_detect_command(CLI::App& app, const GlobalOptions& global) {
       ->required();
   eval->add_option("--det", eval_args->detections, "Detections (MOT format)")->required();
   eval->add_option("--iou", eval_args->options.iou_threshold, "IoU threshold of a match")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   eval->add_option("--min-visibility", eval_args->options.min_visibility,
                    "MOT16/17: pedestrians less visible than this are ignored")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   eval->callback([eval_args, &global] { run_detect_eval(*eval_args, global); });
 }
 

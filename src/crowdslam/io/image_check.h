@@ -5,7 +5,9 @@
 // a warning on stderr that names no file) and lets libpng print its complaints too. So:
 //   - JPEG (starts FF D8) is decoded with libjpeg directly (jpeg_decode.h): every libjpeg error or
 //     warning is an InputError naming the file and libjpeg's message. Bytes after the end-of-image
-//     marker are accepted (some writers pad files).
+//     marker are accepted (some writers pad files). JPEG has no checksum: damage that libjpeg decodes
+//     without complaint (a single flipped bit often is: Huffman codes resynchronise) cannot be found;
+//     truncation and damaged runs of bytes practically always are.
 //   - PNG: before decoding, the chunk structure is walked and every chunk's CRC checked; a file cut
 //     short (before IEND) or with a flipped bit is an error naming the file, and libpng never sees it.
 //   - Other formats are only checked by decoding (cv::imdecode).
