@@ -208,5 +208,14 @@ TEST(DatasetFrameSize, ColourFrameOfAnotherSizeNamesTheColourFileAndTheFirstFram
   }
 }
 
+TEST(DatasetFrameSize, ImageFoldersMayHoldImagesOfAnySize) {
+  TempDir dir;
+  test::write_colour(dir / "a.png", 1, {8, 6});
+  test::write_colour(dir / "b.png", 2, {16, 4});  // e.g. photos for vocabulary training
+  const auto dataset = open_dataset(dir.path().string());
+  EXPECT_EQ(dataset->load(0).colour.size(), cv::Size(8, 6));
+  EXPECT_EQ(dataset->load(1).colour.size(), cv::Size(16, 4));
+}
+
 }  // namespace
 }  // namespace crowdslam::io

@@ -64,7 +64,8 @@ FrameImages Dataset::load(std::size_t index) const {
   const FrameInfo& info = frame_info(index);
   FrameImages images;
   images.colour = read_colour_image(info.colour_path);
-  if (const auto expected = reference_size(index, images.colour); expected && images.colour.size() != *expected) {
+  if (const auto expected = contents_.same_size_frames ? reference_size(index, images.colour) : std::nullopt;
+      expected && images.colour.size() != *expected) {
     const auto text = [](const cv::Size& s) { return std::to_string(s.width) + "x" + std::to_string(s.height); };
     throw input_error(clipped(info.colour_path),
                       "colour image is " + text(images.colour.size()) + ", but the first frame's (" +

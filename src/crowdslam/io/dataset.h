@@ -17,8 +17,8 @@
 // that cannot be checked, e.g. too long or a symlink loop, is "LIST:LINE: PATH: reason"); load(i)
 // additionally decodes the images strictly (image_check.h: truncated or corrupt JPEG/PNG are errors),
 // checks that depth is 16-bit, that the colour image has the size of the first frame's colour image
-// (the message names the colour file and both sizes), and that depth / right images have the colour
-// image's size. Paths and list lines quoted in messages are clipped (input_text.h).
+// (the message names the colour file and both sizes; not for image folders), and that depth / right
+// images have the colour image's size. Paths and list lines quoted in messages are clipped (input_text.h).
 //
 // Nothing is dropped silently: entries a reader skips (duplicated time stamps, EuRoC left images without
 // a right image) are counted and warned about once (spdlog::warn) with the first LIST:LINE; see the
@@ -118,6 +118,9 @@ struct DatasetContents {
   Trajectory ground_truth;
   std::string ground_truth_path;
   double fps = 0.0;
+  // load() checks every colour image against frame 0's size (a camera's sequence). False for image
+  // folders, which may hold photos of any size (vocabulary training); a SLAM run checks sizes itself.
+  bool same_size_frames = true;
 };
 
 class Dataset : public FrameSource {

@@ -61,6 +61,7 @@ std::unique_ptr<Dataset> open_image_folder_dataset(const std::string& directory,
   DatasetContents c;
   c.directory = directory;
   c.layout = "images";
+  c.same_size_frames = false;  // photos of any size (e.g. for vocabulary training)
   c.sensor = SensorKind::kMonocular;
   c.fps = options.fps > 0 ? options.fps : kDefaultImageFolderFps;
   for (std::size_t i = 0; i < files.size(); ++i)

@@ -1,8 +1,9 @@
 #pragma once
 // A folder of images (monocular): every file with an image extension (png, jpg, jpeg, bmp, pgm, ppm, tif,
 // tiff; any case), sorted by name; frame i has timestamp i / fps (DatasetOptions::fps, default 30).
-// No ground truth. An entry with an image name that cannot be checked (a symlink loop) is an error naming
-// it; one that is not a regular file (a folder, a dangling symlink) is skipped with one warning.
+// No ground truth. Images may differ in size (Dataset::load does not compare them with the first).
+// An entry with an image name that cannot be checked (a symlink loop) is an error naming it; one that
+// is not a regular file (a folder, a dangling symlink) is skipped with one warning.
 #include <memory>
 #include <string>
 
