@@ -91,11 +91,11 @@ void warn_unpaired(const std::map<long long, ListEntry>& left, const std::map<lo
   const std::string left_list = clipped((mav0 / "cam0" / "data.csv").string());
   const std::string right_list = clipped((mav0 / "cam1" / "data.csv").string());
   if (left_only > 0) {
-    spdlog::warn("{}:{}: {} of {} left images have no right image with the same time stamp in {} (and {} right "
-                 "images no left one); stereo skips them",
+    spdlog::warn("{}:{}: {} of {} left images have no right image with the same time stamp in {}; stereo skips "
+                 "them ({} right image(s) without a left one)",
                  left_list, first_line, left_only, left.size(), right_list, right_only);
   } else {
-    spdlog::warn("{}: {} of {} right images have no left image with the same time stamp in {}; they are skipped",
+    spdlog::warn("{}: {} of {} right images have no left image with the same time stamp in {}; stereo skips them",
                  right_list, right_only, right.size(), left_list);
   }
 }
