@@ -17,7 +17,9 @@ using crowdslam::test::shared_data;
 using crowdslam::test::TempDir;
 using crowdslam::test::write_text;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 int line_count(const std::string& text) {
   int lines = 0;
@@ -34,8 +36,10 @@ void make_tum(const fs::path& dir) {
   fs::create_directories(dir / "rgb");
   fs::create_directories(dir / "depth");
   for (int i = 0; i < 2; ++i) {
-    cv::imwrite((dir / "rgb" / (std::to_string(i) + ".png")).string(), cv::Mat(6, 8, CV_8UC3, cv::Scalar(i, 2, 3)));
-    cv::imwrite((dir / "depth" / (std::to_string(i) + ".png")).string(), cv::Mat(6, 8, CV_16UC1, cv::Scalar(1000)));
+    cv::imwrite((dir / "rgb" / (std::to_string(i) + ".png")).string(),
+                cv::Mat(6, 8, CV_8UC3, cv::Scalar(i, 2, 3)));
+    cv::imwrite((dir / "depth" / (std::to_string(i) + ".png")).string(),
+                cv::Mat(6, 8, CV_16UC1, cv::Scalar(1000)));
   }
   write_text(dir / "rgb.txt", "0.0 rgb/0.png\n1.0 rgb/1.png\n");
   write_text(dir / "depth.txt", "0.0 depth/0.png\n1.0 depth/1.png\n");
@@ -50,8 +54,10 @@ fs::path copy_two_bonn_frames(const fs::path& dir) {
   const char* depth[] = {"1548339819.88851", "1548339819.92187"};
   std::string rgb_list, depth_list;
   for (int i = 0; i < 2; ++i) {
-    fs::copy_file(bonn / "rgb" / (std::string(rgb[i]) + ".jpg"), dir / "rgb" / (std::string(rgb[i]) + ".jpg"));
-    fs::copy_file(bonn / "depth" / (std::string(depth[i]) + ".png"), dir / "depth" / (std::string(depth[i]) + ".png"));
+    fs::copy_file(bonn / "rgb" / (std::string(rgb[i]) + ".jpg"),
+                  dir / "rgb" / (std::string(rgb[i]) + ".jpg"));
+    fs::copy_file(bonn / "depth" / (std::string(depth[i]) + ".png"),
+                  dir / "depth" / (std::string(depth[i]) + ".png"));
     rgb_list += std::string(rgb[i]) + " rgb/" + rgb[i] + ".jpg\n";
     depth_list += std::string(depth[i]) + " depth/" + depth[i] + ".png\n";
   }
@@ -93,7 +99,8 @@ TEST(CliInput, CheckFailsOnACutBonnJpegThatStillEndsWithTheEndMarker) {
   const auto r = run_cli({"dataset", "info", "--check", dir.path().string()});
   EXPECT_EQ(r.exit_code, 1);  // used to pass: libjpeg printed a warning naming no file
   EXPECT_EQ(line_count(r.err), 1) << r.err;
-  EXPECT_TRUE(contains(r.err, "error: " + second.string() + ": corrupt JPEG image: Corrupt JPEG data")) << r.err;
+  EXPECT_TRUE(contains(r.err, "error: " + second.string() + ": corrupt JPEG image: Corrupt JPEG data"))
+      << r.err;
 }
 
 TEST(CliInput, CheckFailsOnFlippedBitsInABonnJpeg) {
@@ -102,7 +109,8 @@ TEST(CliInput, CheckFailsOnFlippedBitsInABonnJpeg) {
   const fs::path second = copy_two_bonn_frames(dir.path());
   std::vector<char> jpeg = bytes_of(second);
   // 64 bytes: a single flipped bit often decodes without complaint (JPEG has no checksum).
-  for (std::size_t i = jpeg.size() / 2; i < jpeg.size() / 2 + 64; ++i) jpeg[i] = static_cast<char>(jpeg[i] ^ 0x5A);
+  for (std::size_t i = jpeg.size() / 2; i < jpeg.size() / 2 + 64; ++i)
+    jpeg[i] = static_cast<char>(jpeg[i] ^ 0x5A);
   write_bytes(second, jpeg);
   const auto r = run_cli({"dataset", "info", "--check", dir.path().string()});
   EXPECT_EQ(r.exit_code, 1);
@@ -148,13 +156,15 @@ TEST(CliInput, DetectThreadsOutOfRangeIsAClearErrorNotACrash) {
 TEST(CliInput, DetectNumericOptionsAreBounded) {
   TempDir dir;
   make_tum(dir.path());
-  const std::vector<std::pair<std::string, std::string>> bad = {
-      {"--max-frames", "-1"}, {"--input-size", "320000"}, {"--confidence", "7"}, {"--nms", "-0.5"},
-      {"--person-class", "-3"}};
+  const std::vector<std::pair<std::string, std::string>> bad = {{"--max-frames", "-1"},
+                                                                {"--input-size", "320000"},
+                                                                {"--confidence", "7"},
+                                                                {"--nms", "-0.5"},
+                                                                {"--person-class", "-3"}};
   for (const auto& [option, value] : bad) {
     SCOPED_TRACE(option);
-    const auto r = run_cli({"detect", "--dataset", dir.path().string(), "--out", (dir / "det.txt").string(),
-                            option, value});
+    const auto r = run_cli(
+        {"detect", "--dataset", dir.path().string(), "--out", (dir / "det.txt").string(), option, value});
     EXPECT_NE(r.exit_code, 0);
     EXPECT_LT(r.exit_code, 128);
     EXPECT_TRUE(contains(r.err, option)) << r.err;
@@ -189,7 +199,8 @@ TEST(CliInput, SharedDatasetsOpenAndCheckWithoutWarnings) {
   }
   if (!crowdslam::test::shared_available("euroc_v101_micro")) GTEST_SKIP() << "no euroc_v101_micro";
   // --check decodes every frame with the strict decoders: the real data must pass.
-  const auto checked = run_cli({"--json", "dataset", "info", "--check", shared_data("euroc_v101_micro").string()});
+  const auto checked =
+      run_cli({"--json", "dataset", "info", "--check", shared_data("euroc_v101_micro").string()});
   ASSERT_EQ(checked.exit_code, 0) << checked.err;
   EXPECT_FALSE(has_warning(checked)) << checked.err;
 }

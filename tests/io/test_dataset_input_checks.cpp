@@ -18,7 +18,9 @@ using test::error_of;
 using test::TempDir;
 using test::write_text;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 TEST(OpenSourceInput, ListFileGivenAsTheDatasetAsksForTheDirectory) {
   TempDir dir;
@@ -57,7 +59,8 @@ TEST(DatasetPathErrors, SymlinkLoopNamesListLineAndReason) {
   fs::create_symlink("a.png", dir / "rgb" / "b.png");
   write_text(dir / "rgb.txt", "0.0 rgb/0.png\n0.5 rgb/a.png\n");
   const std::string message = error_of([&] { (void)open_dataset(dir.path().string()); });
-  EXPECT_TRUE(contains(message, (dir / "rgb.txt").string() + ":2: listed image " + (dir / "rgb/a.png").string()))
+  EXPECT_TRUE(
+      contains(message, (dir / "rgb.txt").string() + ":2: listed image " + (dir / "rgb/a.png").string()))
       << message;
   EXPECT_TRUE(contains(message, "Too many levels of symbolic links")) << message;
 }
@@ -87,7 +90,8 @@ TEST(DatasetPathErrors, SymlinkLoopInEurocKittiAndImageFolders) {
   fs::create_symlink("c.png", folder / "b.png");
   fs::create_symlink("b.png", folder / "c.png");
   message = error_of([&] { (void)open_dataset(folder.path().string()); });
-  EXPECT_TRUE(contains(message, (folder / "b.png").string()) || contains(message, (folder / "c.png").string()))
+  EXPECT_TRUE(contains(message, (folder / "b.png").string()) ||
+              contains(message, (folder / "c.png").string()))
       << message;
   EXPECT_TRUE(contains(message, "Too many levels of symbolic links")) << message;
 }
@@ -114,7 +118,8 @@ TEST(DatasetStamps, DuplicatedStampsAreSkippedWithOneWarningNamingTheFirstRepeat
   EXPECT_EQ(dataset->summary().colour_entries, 4u);
   const auto warnings = log.warnings();
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_TRUE(contains(warnings[0], (dir / "rgb.txt").string() + ":3: 2 entries repeat a time stamp")) << warnings[0];
+  EXPECT_TRUE(contains(warnings[0], (dir / "rgb.txt").string() + ":3: 2 entries repeat a time stamp"))
+      << warnings[0];
   EXPECT_TRUE(contains(warnings[0], "line 2")) << warnings[0];
 }
 
@@ -139,7 +144,8 @@ TEST(DatasetStamps, HugeNegativeAndNonFiniteStampsNameFileAndLine) {
   test::write_grey(kitti / "image_0/000000.png", 0);
   write_text(kitti / "times.txt", "1e300\n");
   write_text(kitti / "calib.txt", "P0: 700 0 600 0 0 710 180 0 0 0 1 0\n");
-  EXPECT_TRUE(contains(error_of([&] { (void)open_dataset(kitti.path().string()); }), "times.txt:1: timestamp"));
+  EXPECT_TRUE(
+      contains(error_of([&] { (void)open_dataset(kitti.path().string()); }), "times.txt:1: timestamp"));
 }
 
 TEST(DatasetStamps, NoColourDepthPairIsAnErrorNamingBothLists) {
@@ -154,7 +160,8 @@ TEST(DatasetStamps, NoColourDepthPairIsAnErrorNamingBothLists) {
 
 void make_euroc_lists(const fs::path& dir, int left, int right) {
   const std::string yaml =
-      "%YAML:1.0\nT_BS:\n  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, "
+      "%YAML:1.0\nT_BS:\n  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, "
+      "1.0, "
       "0.0, 0.0, 0.0, 0.0, 1.0]\nrate_hz: 20\nresolution: [8, 6]\nintrinsics: [400.0, 401.0, 4.0, 3.0]\n"
       "distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
   for (const auto& [cam, count] : {std::pair{"cam0", left}, {"cam1", right}}) {
@@ -178,7 +185,8 @@ TEST(EurocStereo, ShorterRightListSkipsLeftFramesWithOneWarning) {
   const auto warnings = log.warnings();
   ASSERT_EQ(warnings.size(), 1u);
   // First unpaired left frame: stamp 1049 on line 51 of cam0/data.csv (header on line 1).
-  EXPECT_TRUE(contains(warnings[0], "cam0/data.csv:51: 46 of 95 left images have no right image")) << warnings[0];
+  EXPECT_TRUE(contains(warnings[0], "cam0/data.csv:51: 46 of 95 left images have no right image"))
+      << warnings[0];
 }
 
 TEST(EurocStereo, EqualListsGiveNoWarning) {
@@ -200,7 +208,8 @@ TEST(DatasetFrameSize, ColourFrameOfAnotherSizeNamesTheColourFileAndTheFirstFram
       EXPECT_NO_THROW((void)dataset->load(0));
     }
     const std::string message = error_of([&] { (void)dataset->load(1); });
-    EXPECT_TRUE(contains(message, (dir / "rgb/1.png").string() + ": colour image is 4x3, but the first frame's (" +
+    EXPECT_TRUE(contains(message, (dir / "rgb/1.png").string() +
+                                      ": colour image is 4x3, but the first frame's (" +
                                       (dir / "rgb/0.png").string() + ") is 8x6"))
         << message;
     EXPECT_FALSE(contains(message, "depth")) << message;

@@ -72,8 +72,8 @@ TEST(JpegDecode, ExifOrientationIsAppliedAsImreadDoes) {
   test::TempDir dir;
   Bytes jpeg = read_bytes(noise_jpeg(dir, "plain.jpg"));
   // APP1 "Exif" with a little-endian TIFF IFD0 holding one entry: Orientation (0x0112) = 6 (rotate 90 CW).
-  const Bytes exif = {'E', 'x', 'i', 'f', 0, 0, 'I', 'I', 0x2A, 0, 8, 0, 0, 0, 1, 0, 0x12, 0x01,
-                      3,   0,   1,   0,   0, 0, 6,   0,   0,    0, 0, 0, 0, 0};
+  const Bytes exif = {'E',  'x',  'i', 'f', 0, 0, 'I', 'I', 0x2A, 0, 8, 0, 0, 0, 1, 0,
+                      0x12, 0x01, 3,   0,   1, 0, 0,   0,   6,    0, 0, 0, 0, 0, 0, 0};
   Bytes app1 = {0xFF, 0xE1, 0, static_cast<unsigned char>(exif.size() + 2)};
   app1.insert(app1.end(), exif.begin(), exif.end());
   jpeg.insert(jpeg.begin() + 2, app1.begin(), app1.end());
@@ -108,7 +108,7 @@ TEST(JpegDecodeErrors, TruncatedJpegThatStillEndsWithTheEndMarkerNamesTheFile) {
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(message.find(path.string() + ": corrupt JPEG image: "), std::string::npos) << message;
   EXPECT_NE(message.find("Corrupt JPEG data"), std::string::npos) << message;  // libjpeg's own words
-  EXPECT_EQ(err, "");                                                            // and libjpeg printed nothing
+  EXPECT_EQ(err, "");                                                          // and libjpeg printed nothing
 }
 
 // JPEG has no checksum: a flipped bit that libjpeg decodes without complaint (Huffman codes often

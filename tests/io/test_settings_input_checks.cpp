@@ -17,7 +17,9 @@ using test::error_of;
 using test::TempDir;
 using test::write_text;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 std::string config(const std::string& name) { return (test::source_dir() / "config" / name).string(); }
 
@@ -45,15 +47,18 @@ std::string tum1_with(const TempDir& dir, const std::string& key, const std::str
 TEST(SettingsKeys, UnknownKeyIsWarnedWithFileLineAndTheClosestKnownKey) {
   TempDir dir;
   int line = 0;
-  const std::string path = tum1_plus(dir, "Camera.fxx: 517.3\nRGBD.DepthMapFactor: 5000.0\nFoo.bar: 1\n", &line);
+  const std::string path =
+      tum1_plus(dir, "Camera.fxx: 517.3\nRGBD.DepthMapFactor: 5000.0\nFoo.bar: 1\n", &line);
   test::LogCapture log;
   const Settings s = load_settings(path, SensorKind::kRgbd);
   EXPECT_DOUBLE_EQ(s.camera.fx, 517.306408);  // the known key is read, the unknown one ignored
   const auto warnings = log.warnings();
   ASSERT_EQ(warnings.size(), 3u);
-  EXPECT_EQ(warnings[0], path + ":" + std::to_string(line) + ": Camera.fxx: unknown key, ignored (did you mean Camera.fx?)");
-  EXPECT_TRUE(contains(warnings[1], ":" + std::to_string(line + 1) + ": RGBD.DepthMapFactor: unknown key, ignored "
-                                    "(did you mean DepthMapFactor?)"))
+  EXPECT_EQ(warnings[0], path + ":" + std::to_string(line) +
+                             ": Camera.fxx: unknown key, ignored (did you mean Camera.fx?)");
+  EXPECT_TRUE(contains(warnings[1], ":" + std::to_string(line + 1) +
+                                        ": RGBD.DepthMapFactor: unknown key, ignored "
+                                        "(did you mean DepthMapFactor?)"))
       << warnings[1];
   EXPECT_EQ(warnings[2], path + ":" + std::to_string(line + 2) + ": Foo.bar: unknown key, ignored");
 }
@@ -73,12 +78,13 @@ TEST(SettingsKeys, ManyUnknownKeysAreWarnedTenTimesThenCounted) {
 TEST(SettingsKeys, OrbSlamKeysWeDoNotUseAreAcceptedSilently) {
   TempDir dir;
   // The keys ORB-SLAM2's published TUM/EuRoC/KITTI files carry beside the ones we read.
-  const std::string path = tum1_plus(dir,
-                                     "Camera.type: \"PinHole\"\nCamera.bFishEye: 0\nFile.version: \"1.0\"\n"
-                                     "Viewer.KeyFrameSize: 0.05\nViewer.KeyFrameLineWidth: 1\nViewer.GraphLineWidth: 0.9\n"
-                                     "Viewer.PointSize:2\nViewer.CameraSize: 0.08\nViewer.CameraLineWidth: 3\n"
-                                     "Viewer.ViewpointX: 0\nViewer.ViewpointY: -0.7\nViewer.ViewpointZ: -1.8\n"
-                                     "Viewer.ViewpointF: 500\nIMU.Frequency: 200\n");
+  const std::string path =
+      tum1_plus(dir,
+                "Camera.type: \"PinHole\"\nCamera.bFishEye: 0\nFile.version: \"1.0\"\n"
+                "Viewer.KeyFrameSize: 0.05\nViewer.KeyFrameLineWidth: 1\nViewer.GraphLineWidth: 0.9\n"
+                "Viewer.PointSize:2\nViewer.CameraSize: 0.08\nViewer.CameraLineWidth: 3\n"
+                "Viewer.ViewpointX: 0\nViewer.ViewpointY: -0.7\nViewer.ViewpointZ: -1.8\n"
+                "Viewer.ViewpointF: 500\nIMU.Frequency: 200\n");
   test::LogCapture log;
   EXPECT_NO_THROW((void)load_settings(path, SensorKind::kRgbd));
   EXPECT_TRUE(log.warnings().empty()) << log.warnings().front();
@@ -101,7 +107,8 @@ TEST(SettingsKeys, KeySetTwiceIsAnErrorNamingBothLines) {
   int line = 0;
   const std::string path = tum1_plus(dir, "Camera.fx: 500.0\n", &line);
   const std::string text = test::read_text(path);
-  const int first = static_cast<int>(std::count(text.begin(), text.begin() + text.find("Camera.fx:"), '\n')) + 1;
+  const int first =
+      static_cast<int>(std::count(text.begin(), text.begin() + text.find("Camera.fx:"), '\n')) + 1;
   const std::string message = error_of([&] { (void)load_settings(path, SensorKind::kRgbd); });
   EXPECT_EQ(message, path + ":" + std::to_string(line) + ": Camera.fx: set twice (first on line " +
                          std::to_string(first) + ")");
@@ -143,10 +150,14 @@ TEST_P(SettingsComponentBounds, AreReportedWithFileAndKey) {
 INSTANTIATE_TEST_SUITE_P(
     Components, SettingsComponentBounds,
     ::testing::Values(
-        Bound{"ORBextractor.iniThFAST", "ORBextractor.iniThFAST: 300", "ORBextractor.iniThFAST: must be <= 254"},
-        Bound{"ORBextractor.nFeatures", "ORBextractor.nFeatures: 2000000000", "ORBextractor.nFeatures: must be <= 100000"},
-        Bound{"ORBextractor.scaleFactor", "ORBextractor.scaleFactor: 1.00000001", "ORBextractor.scaleFactor: must be > 1"},
-        Bound{"ORBextractor.scaleFactor", "ORBextractor.scaleFactor: 100.0", "ORBextractor.scaleFactor: must be <= 4"},
+        Bound{"ORBextractor.iniThFAST", "ORBextractor.iniThFAST: 300",
+              "ORBextractor.iniThFAST: must be <= 254"},
+        Bound{"ORBextractor.nFeatures", "ORBextractor.nFeatures: 2000000000",
+              "ORBextractor.nFeatures: must be <= 100000"},
+        Bound{"ORBextractor.scaleFactor", "ORBextractor.scaleFactor: 1.00000001",
+              "ORBextractor.scaleFactor: must be > 1"},
+        Bound{"ORBextractor.scaleFactor", "ORBextractor.scaleFactor: 100.0",
+              "ORBextractor.scaleFactor: must be <= 4"},
         Bound{"Camera.fps", "Camera.fps: 1e300", "Camera.fps: must be <= 10000"},
         Bound{"Camera.width", "Camera.width: 70000", "Camera.width: must be <= 65535"},
         Bound{"Detector.input_size", "Detector.input_size: 320000", "Detector.input_size: must be <= 2048"},

@@ -27,8 +27,10 @@ TEST(MotInput, NegativeAndHugeBoxesAreSkippedCountedAndWarnedOnce) {
   EXPECT_EQ(file.first_dropped_line, 2);
   const auto warnings = log.warnings();
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_EQ(warnings[0], path + ":2: 4 boxes skipped: 2 with zero or negative width/height, 2 with a coordinate or "
-                                "size beyond 1e6 pixels");
+  EXPECT_EQ(warnings[0],
+            path +
+                ":2: 4 boxes skipped: 2 with zero or negative width/height, 2 with a coordinate or "
+                "size beyond 1e6 pixels");
 }
 
 TEST(MotInput, TheMotFileDetectorWarnsOnceToo) {

@@ -66,7 +66,9 @@ FrameImages Dataset::load(std::size_t index) const {
   images.colour = read_colour_image(info.colour_path);
   if (const auto expected = contents_.same_size_frames ? reference_size(index, images.colour) : std::nullopt;
       expected && images.colour.size() != *expected) {
-    const auto text = [](const cv::Size& s) { return std::to_string(s.width) + "x" + std::to_string(s.height); };
+    const auto text = [](const cv::Size& s) {
+      return std::to_string(s.width) + "x" + std::to_string(s.height);
+    };
     throw input_error(clipped(info.colour_path),
                       "colour image is " + text(images.colour.size()) + ", but the first frame's (" +
                           clipped(contents_.frames.front().colour_path) + ") is " + text(*expected) +

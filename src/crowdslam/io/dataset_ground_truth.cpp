@@ -9,7 +9,8 @@ namespace {
 
 void require_file(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw input_error(path, "ground-truth file does not exist");
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw input_error(path, "ground-truth file does not exist");
 }
 
 }  // namespace

@@ -48,7 +48,8 @@ std::vector<ListEntry> read_tum_list(const std::string& path) {
     const int line = static_cast<int>(i + 1);
     const auto fields = split_fields(lines[i], false);
     if (fields.size() < 2)
-      throw input_error(clipped(path), line, "expected 'timestamp filename', got '" + clipped(trim(lines[i])) + "'");
+      throw input_error(clipped(path), line,
+                        "expected 'timestamp filename', got '" + clipped(trim(lines[i])) + "'");
     entries.push_back({parse_stamp(fields[0], path, line), 0, fields[1], line});
   }
   if (entries.empty()) throw input_error(clipped(path), "list is empty");
@@ -103,8 +104,8 @@ void require_listed_file(const std::string& file, const std::string& list, int l
     throw input_error(clipped(list), line, "listed image " + clipped(file) + " is not a regular file");
 }
 
-std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& entries, const std::string& list,
-                                                bool by_ns) {
+std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& entries,
+                                                const std::string& list, bool by_ns) {
   std::map<double, std::size_t> by_seconds;
   std::map<long long, std::size_t> by_nanoseconds;
   std::size_t duplicates = 0;
@@ -130,9 +131,10 @@ std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& en
     *slot = i;  // the later entry wins
   }
   if (duplicates > 0)
-    spdlog::warn("{}:{}: {} entr{} repeat a time stamp listed before (the first repeats line {}); of equal "
-                 "stamps the later entry is used, the earlier skipped (as TUM's associate.py does)",
-                 clipped(list), first_repeat, duplicates, duplicates == 1 ? "y" : "ies", first_original);
+    spdlog::warn(
+        "{}:{}: {} entr{} repeat a time stamp listed before (the first repeats line {}); of equal "
+        "stamps the later entry is used, the earlier skipped (as TUM's associate.py does)",
+        clipped(list), first_repeat, duplicates, duplicates == 1 ? "y" : "ies", first_original);
   std::vector<ListEntry> kept;
   kept.reserve(entries.size() - duplicates);
   if (by_ns) {

@@ -35,8 +35,8 @@ void require_listed_file(const std::string& file, const std::string& list, int l
 // The entries kept when the list is read into a dict keyed by stamp (`by_ns`: timestamp_ns, else
 // timestamp_s): of equal stamps the later entry wins, as in TUM's associate.py. Ascending by stamp.
 // Duplicates are counted and warned about once (spdlog::warn) naming LIST:LINE of the first repeat.
-std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& entries, const std::string& list,
-                                                bool by_ns = false);
+std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& entries,
+                                                const std::string& list, bool by_ns = false);
 
 bool is_comment_or_blank(const std::string& line);
 

@@ -46,7 +46,8 @@ bool looks_like_text(const std::string& path) {
 // Refuses a list, settings or other text file given where a dataset directory or a video is expected:
 // `--dataset DIR/rgb.txt` used to be opened as a video and fail obscurely.
 void refuse_text_file(const std::string& spec) {
-  static const char* const kTextExtensions[] = {".txt", ".csv", ".yaml", ".yml", ".json", ".ini", ".md", ".xml"};
+  static const char* const kTextExtensions[] = {".txt",  ".csv", ".yaml", ".yml",
+                                                ".json", ".ini", ".md",   ".xml"};
   const std::string ext = lower_extension(spec);
   const bool text_extension = std::any_of(std::begin(kTextExtensions), std::end(kTextExtensions),
                                           [&](const char* e) { return ext == e; });
@@ -89,7 +90,8 @@ std::unique_ptr<FrameSource> open_source(const std::string& spec, const DatasetO
   const fs::file_status status = fs::status(spec, ec);
   if (all_digits && status.type() == fs::file_type::not_found)
     return VideoSource::open_camera(std::stoi(spec), options);
-  if (status.type() == fs::file_type::not_found) throw input_error(clipped(spec), "no such file or directory");
+  if (status.type() == fs::file_type::not_found)
+    throw input_error(clipped(spec), "no such file or directory");
   if (ec) throw input_error(clipped(spec), "cannot access: " + ec.message());
   if (fs::is_directory(status)) return open_dataset(spec, options);
   if (fs::is_regular_file(status)) {

@@ -71,7 +71,8 @@ std::map<long long, ListEntry> camera_entries(const fs::path& cam_dir, std::size
     require_listed_file(row.file, list, row.line);
   }
   std::map<long long, ListEntry> entries;
-  for (auto& row : without_duplicate_stamps(rows, list, true)) entries.emplace(row.timestamp_ns, std::move(row));
+  for (auto& row : without_duplicate_stamps(rows, list, true))
+    entries.emplace(row.timestamp_ns, std::move(row));
   return entries;
 }
 
@@ -91,19 +92,22 @@ void warn_unpaired(const std::map<long long, ListEntry>& left, const std::map<lo
   const std::string left_list = clipped((mav0 / "cam0" / "data.csv").string());
   const std::string right_list = clipped((mav0 / "cam1" / "data.csv").string());
   if (left_only > 0) {
-    spdlog::warn("{}:{}: {} of {} left images have no right image with the same time stamp in {}; stereo skips "
-                 "them ({} right image(s) without a left one)",
-                 left_list, first_line, left_only, left.size(), right_list, right_only);
+    spdlog::warn(
+        "{}:{}: {} of {} left images have no right image with the same time stamp in {}; stereo skips "
+        "them ({} right image(s) without a left one)",
+        left_list, first_line, left_only, left.size(), right_list, right_only);
   } else {
-    spdlog::warn("{}: {} of {} right images have no left image with the same time stamp in {}; stereo skips them",
-                 right_list, right_only, right.size(), left_list);
+    spdlog::warn(
+        "{}: {} of {} right images have no left image with the same time stamp in {}; stereo skips them",
+        right_list, right_only, right.size(), left_list);
   }
 }
 
 }  // namespace
 
 EurocCameraCalibration read_euroc_camera_calibration(const std::string& sensor_yaml) {
-  if (!regular_file_exists(sensor_yaml)) throw input_error(clipped(sensor_yaml), "calibration file does not exist");
+  if (!regular_file_exists(sensor_yaml))
+    throw input_error(clipped(sensor_yaml), "calibration file does not exist");
   try {
     cv::FileStorage storage(sensor_yaml, cv::FileStorage::READ);
     if (!storage.isOpened()) throw input_error(sensor_yaml, "cannot open calibration file");
@@ -118,7 +122,9 @@ std::optional<geometry::Mat4> EurocDataset::right_from_left() const {
   return geometry::Mat4(right_->body_from_sensor.inverse() * left_.body_from_sensor);
 }
 
-bool looks_like_euroc(const std::string& directory) { return regular_file_exists(mav0_of(directory) / "cam0" / "data.csv"); }
+bool looks_like_euroc(const std::string& directory) {
+  return regular_file_exists(mav0_of(directory) / "cam0" / "data.csv");
+}
 
 std::unique_ptr<EurocDataset> open_euroc_dataset(const std::string& directory,
                                                  const DatasetOptions& options) {

@@ -22,7 +22,8 @@ constexpr std::uintmax_t kMaxImageFileBytes = std::uintmax_t{1} << 30;
 std::vector<unsigned char> read_image_bytes(const std::string& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (status.type() == fs::file_type::not_found) throw input_error(clipped(path), "image file does not exist");
+  if (status.type() == fs::file_type::not_found)
+    throw input_error(clipped(path), "image file does not exist");
   if (ec) throw input_error(clipped(path), "cannot access image file: " + ec.message());
   if (!fs::is_regular_file(status)) throw input_error(clipped(path), "image path is not a regular file");
   const std::uintmax_t size = fs::file_size(path, ec);
@@ -116,9 +117,10 @@ void check_png_chunks(const std::vector<unsigned char>& bytes, const std::string
 
 cv::Mat decode(const std::string& path, int flags) {
   const std::vector<unsigned char> bytes = read_image_bytes(path);
-  if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) return decode_jpeg(bytes.data(), bytes.size(), path);
-  const bool is_png =
-      bytes.size() >= kPngSignature.size() && std::equal(kPngSignature.begin(), kPngSignature.end(), bytes.begin());
+  if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8)
+    return decode_jpeg(bytes.data(), bytes.size(), path);
+  const bool is_png = bytes.size() >= kPngSignature.size() &&
+                      std::equal(kPngSignature.begin(), kPngSignature.end(), bytes.begin());
   if (is_png) check_png_chunks(bytes, path);
   cv::Mat image;
   try {
@@ -149,7 +151,8 @@ void check_same_size(const cv::Mat& image, const cv::Size& expected, const std::
   if (image.size() == expected) return;
   throw input_error(clipped(path), what + " is " + std::to_string(image.cols) + "x" +
                                        std::to_string(image.rows) + ", expected " +
-                                       std::to_string(expected.width) + "x" + std::to_string(expected.height));
+                                       std::to_string(expected.width) + "x" +
+                                       std::to_string(expected.height));
 }
 
 }  // namespace crowdslam::io

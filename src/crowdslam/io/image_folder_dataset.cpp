@@ -35,8 +35,9 @@ std::vector<std::string> image_files(const std::string& directory, bool warn) {
   }
   if (ec) throw input_error(clipped(directory), "cannot list directory: " + ec.message());
   if (warn && skipped > 0)
-    spdlog::warn("{}: {} entr{} with an image name but not a regular file (a folder, a dangling link) skipped", clipped(first_skipped), skipped,
-                 skipped == 1 ? "y" : "ies");
+    spdlog::warn(
+        "{}: {} entr{} with an image name but not a regular file (a folder, a dangling link) skipped",
+        clipped(first_skipped), skipped, skipped == 1 ? "y" : "ies");
   std::sort(files.begin(), files.end());
   return files;
 }

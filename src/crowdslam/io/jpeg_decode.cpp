@@ -1,10 +1,10 @@
 #include "crowdslam/io/jpeg_decode.h"
 
-// jpeglib.h needs FILE and size_t declared first.
 #include <algorithm>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
+// jpeglib.h needs FILE and size_t declared first, jerror.h needs jpeglib.h.
 // clang-format off
 #include <jpeglib.h>
 #include <jerror.h>
@@ -53,7 +53,7 @@ struct Job {
   ErrorManager err;
   bool too_large;
   unsigned width, height;  // of a too large image
-  int orientation;  // EXIF orientation 1..8
+  int orientation;         // EXIF orientation 1..8
 };
 
 unsigned read16(const unsigned char* p, bool little) {
@@ -147,14 +147,32 @@ void cmyk_to_bgr(const cv::Mat& cmyk, cv::Mat& bgr) {
 // As cv::imread's EXIF handling.
 void apply_orientation(cv::Mat& image, int orientation) {
   switch (orientation) {
-    case 2: cv::flip(image, image, 1); break;
-    case 3: cv::flip(image, image, -1); break;
-    case 4: cv::flip(image, image, 0); break;
-    case 5: cv::transpose(image, image); break;
-    case 6: cv::transpose(image, image); cv::flip(image, image, 1); break;
-    case 7: cv::transpose(image, image); cv::flip(image, image, -1); break;
-    case 8: cv::transpose(image, image); cv::flip(image, image, 0); break;
-    default: break;
+    case 2:
+      cv::flip(image, image, 1);
+      break;
+    case 3:
+      cv::flip(image, image, -1);
+      break;
+    case 4:
+      cv::flip(image, image, 0);
+      break;
+    case 5:
+      cv::transpose(image, image);
+      break;
+    case 6:
+      cv::transpose(image, image);
+      cv::flip(image, image, 1);
+      break;
+    case 7:
+      cv::transpose(image, image);
+      cv::flip(image, image, -1);
+      break;
+    case 8:
+      cv::transpose(image, image);
+      cv::flip(image, image, 0);
+      break;
+    default:
+      break;
   }
 }
 
@@ -180,10 +198,10 @@ cv::Mat decode_jpeg(const unsigned char* data, std::size_t size, const std::stri
   jpeg_destroy_decompress(&job.cinfo);
   if (job.too_large)
     throw input_error(clipped(path), "JPEG image of " + std::to_string(job.width) + "x" +
-                                std::to_string(job.height) + " pixels is too large");
+                                         std::to_string(job.height) + " pixels is too large");
   if (!ok) {
     const bool truncated = job.err.code == JWRN_JPEG_EOF || job.err.code == JERR_INPUT_EOF;
-    const std::string what = truncated          ? "truncated JPEG image: "
+    const std::string what = truncated         ? "truncated JPEG image: "
                              : job.err.warning ? "corrupt JPEG image: "
                                                : "cannot decode JPEG image: ";
     throw input_error(clipped(path), what + job.err.message);

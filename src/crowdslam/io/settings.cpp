@@ -161,8 +161,7 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.feature_budget.area == b.feature_budget.area;
   return camera && orb && detector && people && budget && a.th_depth == b.th_depth &&
          a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&
-         a.has_baseline == b.has_baseline &&
-         a.output.trajectory_format == b.output.trajectory_format &&
+         a.has_baseline == b.has_baseline && a.output.trajectory_format == b.output.trajectory_format &&
          same_rectification(a.rectification, b.rectification);
 }
 

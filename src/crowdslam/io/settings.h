@@ -72,7 +72,8 @@ struct PeopleFilterSettings {
   bool enabled = true;
   std::string mode = "depth";  // "depth" (default: measured best on bonn_crowd) | "paper"
   double margin_px = 5.0;
-  double depth_margin_m = 1.0;  // "depth" mode: keypoints this far behind the person are kept (measured: 1.0 best)
+  double depth_margin_m =
+      1.0;  // "depth" mode: keypoints this far behind the person are kept (measured: 1.0 best)
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the
   // stereo match of a kept left keypoint whose right coordinate falls in a (left-image) person box.
   std::string right_image = "matched";

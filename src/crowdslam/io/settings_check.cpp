@@ -184,8 +184,9 @@ void check_image_size(const Settings& settings, cv::Size image, const std::strin
   if (cam.width <= 0 || cam.height <= 0) return;
   if (image.width == cam.width && image.height == cam.height) return;
   const std::string file = settings.path.empty() ? std::string("settings") : clipped(settings.path);
-  throw input_error(clipped(image_path), "image is " + size_text(image.width, image.height) + ", but the settings " +
-                                             file + " give Camera.width/height " + size_text(cam.width, cam.height) +
+  throw input_error(clipped(image_path), "image is " + size_text(image.width, image.height) +
+                                             ", but the settings " + file + " give Camera.width/height " +
+                                             size_text(cam.width, cam.height) +
                                              " (settings for another camera?)");
 }
 

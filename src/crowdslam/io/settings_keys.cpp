@@ -8,26 +8,56 @@ namespace {
 
 // ORB-SLAM2/3 keys of the published TUM/EuRoC/KITTI files that crowdslam has no use for (no viewer, no
 // fisheye model, no IMU); accepted without a warning so those files work as they are.
-const char* const kAcceptedKeys[] = {"Camera.type",      "Camera.bFishEye", "File.version", "Camera.newWidth",
-                                     "Camera.newHeight", "Camera.imageScale", "Tbc"};
+const char* const kAcceptedKeys[] = {
+    "Camera.type",      "Camera.bFishEye",   "File.version", "Camera.newWidth",
+    "Camera.newHeight", "Camera.imageScale", "Tbc"};
 const char* const kAcceptedPrefixes[] = {"Viewer.", "IMU.", "System."};
 
 }  // namespace
 
 const std::vector<std::string>& known_settings_keys() {
   static const std::vector<std::string> keys = [] {
-    std::vector<std::string> k = {
-        "Camera.fx", "Camera.fy", "Camera.cx", "Camera.cy", "Camera.k1", "Camera.k2", "Camera.p1",
-        "Camera.p2", "Camera.k3", "Camera.width", "Camera.height", "Camera.fps", "Camera.bf", "Camera.RGB",
-        "ThDepth", "DepthMapFactor", "ORBextractor.nFeatures", "ORBextractor.scaleFactor",
-        "ORBextractor.nLevels", "ORBextractor.iniThFAST", "ORBextractor.minThFAST",
-        "Detector.model_cfg", "Detector.model_weights", "Detector.input_size", "Detector.confidence",
-        "Detector.nms", "Detector.person_class", "Detector.filter_before_nms", "PeopleFilter.enabled",
-        "PeopleFilter.mode", "PeopleFilter.margin_px", "PeopleFilter.depth_margin_m",
-        "PeopleFilter.right_image", "FeatureBudget.enabled", "FeatureBudget.thresholds",
-        "FeatureBudget.factors", "FeatureBudget.area", "Output.trajectory_format"};
+    std::vector<std::string> k = {"Camera.fx",
+                                  "Camera.fy",
+                                  "Camera.cx",
+                                  "Camera.cy",
+                                  "Camera.k1",
+                                  "Camera.k2",
+                                  "Camera.p1",
+                                  "Camera.p2",
+                                  "Camera.k3",
+                                  "Camera.width",
+                                  "Camera.height",
+                                  "Camera.fps",
+                                  "Camera.bf",
+                                  "Camera.RGB",
+                                  "ThDepth",
+                                  "DepthMapFactor",
+                                  "ORBextractor.nFeatures",
+                                  "ORBextractor.scaleFactor",
+                                  "ORBextractor.nLevels",
+                                  "ORBextractor.iniThFAST",
+                                  "ORBextractor.minThFAST",
+                                  "Detector.model_cfg",
+                                  "Detector.model_weights",
+                                  "Detector.input_size",
+                                  "Detector.confidence",
+                                  "Detector.nms",
+                                  "Detector.person_class",
+                                  "Detector.filter_before_nms",
+                                  "PeopleFilter.enabled",
+                                  "PeopleFilter.mode",
+                                  "PeopleFilter.margin_px",
+                                  "PeopleFilter.depth_margin_m",
+                                  "PeopleFilter.right_image",
+                                  "FeatureBudget.enabled",
+                                  "FeatureBudget.thresholds",
+                                  "FeatureBudget.factors",
+                                  "FeatureBudget.area",
+                                  "Output.trajectory_format"};
     for (const char* side : {"LEFT", "RIGHT"})
-      for (const char* key : {".height", ".width", ".K", ".D", ".R", ".P"}) k.push_back(std::string(side) + key);
+      for (const char* key : {".height", ".width", ".K", ".D", ".R", ".P"})
+        k.push_back(std::string(side) + key);
     return k;
   }();
   return keys;
@@ -36,7 +66,8 @@ const std::vector<std::string>& known_settings_keys() {
 bool is_accepted_settings_key(const std::string& key) {
   const auto& known = known_settings_keys();
   if (std::find(known.begin(), known.end(), key) != known.end()) return true;
-  if (std::any_of(std::begin(kAcceptedKeys), std::end(kAcceptedKeys), [&](const char* k) { return key == k; }))
+  if (std::any_of(std::begin(kAcceptedKeys), std::end(kAcceptedKeys),
+                  [&](const char* k) { return key == k; }))
     return true;
   return std::any_of(std::begin(kAcceptedPrefixes), std::end(kAcceptedPrefixes),
                      [&](const char* p) { return key.rfind(p, 0) == 0; });

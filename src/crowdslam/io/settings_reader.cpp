@@ -30,8 +30,8 @@ std::vector<KeyLine> top_level_keys(const std::vector<std::string>& lines) {
   std::vector<KeyLine> keys;
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const std::string& text = lines[i];
-    if (text.empty() || text[0] == ' ' || text[0] == '\t' || text[0] == '#' || text[0] == '%' || text[0] == '-' ||
-        text[0] == '.')
+    if (text.empty() || text[0] == ' ' || text[0] == '\t' || text[0] == '#' || text[0] == '%' ||
+        text[0] == '-' || text[0] == '.')
       continue;
     const auto colon = text.find(':');
     if (colon == std::string::npos) continue;
@@ -86,7 +86,8 @@ SettingsReader::SettingsReader(std::string path) : path_(std::move(path)) {
   if (status.type() == std::filesystem::file_type::not_found)
     throw input_error(clipped(path_), "settings file does not exist");
   if (ec) throw input_error(clipped(path_), "cannot access settings file: " + ec.message());
-  if (!std::filesystem::is_regular_file(status)) throw input_error(clipped(path_), "settings path is not a regular file");
+  if (!std::filesystem::is_regular_file(status))
+    throw input_error(clipped(path_), "settings path is not a regular file");
   try {
     storage_.open(path_, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
@@ -114,7 +115,8 @@ void SettingsReader::scan_keys() {
     if (is_accepted_settings_key(k.key)) continue;
     if (++unknown > kMaxUnknownKeyWarnings) continue;
     const std::string suggestion = suggestion_for(k.key);
-    warnings_.push_back(file + ":" + std::to_string(k.line) + ": " + clipped(k.key) + ": unknown key, ignored" +
+    warnings_.push_back(file + ":" + std::to_string(k.line) + ": " + clipped(k.key) +
+                        ": unknown key, ignored" +
                         (suggestion.empty() ? std::string() : " (did you mean " + suggestion + "?)"));
   }
   // Keys cv::FileStorage parsed that the line scan did not see (unusual YAML layout): no line to give.

@@ -69,8 +69,8 @@ void write_camera(std::ostream& out, const Settings& s) {
       << (c.rgb ? 1 : 0) << "\n\n";
   out << "# Close/far threshold (baseline multiples)\nThDepth: " << real_text(s.th_depth) << "\n";
   if (s.has_depth_map_factor)
-    out << "# Depth map values factor (raw / factor = metres)\nDepthMapFactor: " << real_text(s.depth_map_factor)
-        << "\n";
+    out << "# Depth map values factor (raw / factor = metres)\nDepthMapFactor: "
+        << real_text(s.depth_map_factor) << "\n";
   out << "\n";
 }
 

@@ -44,7 +44,9 @@ bool regular_file_exists(const fs::path& path) {
 
 }  // namespace
 
-bool looks_like_tum(const std::string& directory) { return regular_file_exists(fs::path(directory) / "rgb.txt"); }
+bool looks_like_tum(const std::string& directory) {
+  return regular_file_exists(fs::path(directory) / "rgb.txt");
+}
 
 std::unique_ptr<Dataset> open_tum_dataset(const std::string& directory, const DatasetOptions& options) {
   options.check();
@@ -67,10 +69,10 @@ std::unique_ptr<Dataset> open_tum_dataset(const std::string& directory, const Da
     if (pairs.empty()) {
       char window[32];
       std::snprintf(window, sizeof(window), "%g", options.max_time_difference_s);
-      throw input_error(clipped(rgb_list),
-                        "no colour image has a depth map in " + clipped(depth_list) + " within " + window +
-                            " s (colour stamps " + span_of(colour_kept) + ", depth stamps " +
-                            span_of(depth_kept) + "); nothing to run on");
+      throw input_error(clipped(rgb_list), "no colour image has a depth map in " + clipped(depth_list) +
+                                               " within " + window + " s (colour stamps " +
+                                               span_of(colour_kept) + ", depth stamps " +
+                                               span_of(depth_kept) + "); nothing to run on");
     }
     for (const auto& pair : pairs) {
       const ListEntry& rgb = colour_kept[pair.first_index];

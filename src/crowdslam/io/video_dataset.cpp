@@ -11,7 +11,8 @@ namespace crowdslam::io {
 std::unique_ptr<VideoSource> VideoSource::open_file(const std::string& path, const DatasetOptions& options) {
   options.check();
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw input_error(clipped(path), "video file does not exist");
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw input_error(clipped(path), "video file does not exist");
   std::unique_ptr<VideoSource> source(new VideoSource(path, false));
   try {
     // FFmpeg handles nearly every file; OpenCV's own MJPEG reader and image-sequence patterns

@@ -17,9 +17,11 @@ double number(const std::string& path, int line, const std::vector<std::string>&
               bool finite) {
   const auto value = parse_double(fields[i]);
   if (!value)
-    throw input_error(path, line, "field " + std::to_string(i + 1) + " is not a number: '" + io::clipped(fields[i]) + "'");
+    throw input_error(
+        path, line, "field " + std::to_string(i + 1) + " is not a number: '" + io::clipped(fields[i]) + "'");
   if (finite && !std::isfinite(*value))
-    throw input_error(path, line, "field " + std::to_string(i + 1) + " is not finite: '" + io::clipped(fields[i]) + "'");
+    throw input_error(path, line,
+                      "field " + std::to_string(i + 1) + " is not finite: '" + io::clipped(fields[i]) + "'");
   return *value;
 }
 
@@ -47,11 +49,13 @@ MotRow parse_row(const std::string& path, int line, const std::vector<std::strin
     const double cls = number(path, line, f, 7, true);
     const double vis = number(path, line, f, 8, true);
     if (cls != std::floor(cls) || cls < -1)
-      throw input_error(path, line,
-                        "9-column ground truth: class (field 8) must be an integer, got '" + io::clipped(f[7]) + "'");
+      throw input_error(
+          path, line,
+          "9-column ground truth: class (field 8) must be an integer, got '" + io::clipped(f[7]) + "'");
     if (vis < 0 || vis > 1)
-      throw input_error(path, line,
-                        "9-column ground truth: visibility (field 9) must be in [0, 1], got '" + io::clipped(f[8]) + "'");
+      throw input_error(
+          path, line,
+          "9-column ground truth: visibility (field 9) must be in [0, 1], got '" + io::clipped(f[8]) + "'");
     row.object_class = static_cast<int>(cls);
     row.visibility = vis;
   }
@@ -79,8 +83,9 @@ MotFile read_mot_file(const std::string& path, bool ground_truth) {
                             std::to_string(fields.size()));
     MotRow row = parse_row(path, line, fields, ground_truth && file.columns == 9);
     const bool empty = !(row.box.width > 0 && row.box.height > 0);
-    const bool out_of_range = std::abs(row.box.x) > kMaxBoxCoordinate || std::abs(row.box.y) > kMaxBoxCoordinate ||
-                              row.box.width > kMaxBoxCoordinate || row.box.height > kMaxBoxCoordinate;
+    const bool out_of_range = std::abs(row.box.x) > kMaxBoxCoordinate ||
+                              std::abs(row.box.y) > kMaxBoxCoordinate || row.box.width > kMaxBoxCoordinate ||
+                              row.box.height > kMaxBoxCoordinate;
     if (empty || out_of_range) {
       ++(empty ? file.dropped_empty : file.dropped_out_of_range);
       if (file.first_dropped_line == 0) file.first_dropped_line = line;
@@ -89,11 +94,12 @@ MotFile read_mot_file(const std::string& path, bool ground_truth) {
     file.rows.push_back(row);
   }
   if (file.first_dropped_line > 0)
-    spdlog::warn("{}:{}: {} box{} skipped: {} with zero or negative width/height, {} with a coordinate or size beyond "
-                 "1e6 pixels",
-                 io::clipped(path), file.first_dropped_line, file.dropped_empty + file.dropped_out_of_range,
-                 file.dropped_empty + file.dropped_out_of_range == 1 ? "" : "es", file.dropped_empty,
-                 file.dropped_out_of_range);
+    spdlog::warn(
+        "{}:{}: {} box{} skipped: {} with zero or negative width/height, {} with a coordinate or size beyond "
+        "1e6 pixels",
+        io::clipped(path), file.first_dropped_line, file.dropped_empty + file.dropped_out_of_range,
+        file.dropped_empty + file.dropped_out_of_range == 1 ? "" : "es", file.dropped_empty,
+        file.dropped_out_of_range);
   return file;
 }
 

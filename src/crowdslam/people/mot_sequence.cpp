@@ -79,9 +79,10 @@ std::unique_ptr<io::Dataset> open_mot_sequence(const std::string& directory) {
       std::snprintf(name, sizeof(name), "%06zu", i);
       const std::string file = (fs::path(im_dir) / (name + ext)).string();
       if (!fs::is_regular_file(file, ec))
-        throw input_error(io::clipped(file), (ec && ec != std::errc::no_such_file_or_directory ? ec.message() + ": " : "") +
-                                                 "missing image (" + io::clipped(ini) + " says seqLength=" +
-                                                 io::clipped(info["seqLength"]) + ")");
+        throw input_error(io::clipped(file),
+                          (ec && ec != std::errc::no_such_file_or_directory ? ec.message() + ": " : "") +
+                              "missing image (" + io::clipped(ini) +
+                              " says seqLength=" + io::clipped(info["seqLength"]) + ")");
       files.push_back(file);
     }
   } else {
