@@ -17,4 +17,4 @@ fi
 # recognise, so the demo filters them with the generator's exact boxes (the MOT-file detector backend).
 # On real data the Yolo-Fastest detector runs instead, e.g.:
 #   build/apps/crowdslam/crowdslam run --dataset ../shared/data/bonn_crowd --settings config/Bonn.yaml --out out/bonn
-"$bin" run --dataset "$seq" --out "$out/run" --detections "$seq/people_gt.txt"
+"$bin" run --dataset "$seq" --out "$out/run" --overwrite --detections "$seq/people_gt.txt"

@@ -5,8 +5,10 @@
 #     thread    TSan in build-tsan/
 #     all       both (default)
 #     --ctest   also build the e2e test executables and run `ctest -L e2e` in the sanitizer build dir
-# Every run uses the default threaded mode (tracking + detection worker + local mapping + frame
-# prefetcher). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are
+# Every run uses the default threaded mode (tracking + detection worker + local mapping + loop closing +
+# frame prefetcher + journal writer), on every sensor: RGB-D (synthetic, bonn_crowd), monocular
+# (bonn_crowd --sensor mono, kitti07_head), stereo (euroc_v101_micro, right-image thread), and a run
+# interrupted by SIGINT mid-way (the fast-stop path). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are
 # also grepped for reports as a second check).
 # Environment: CROWDSLAM_JOBS (default 2), CROWDSLAM_SANITIZE_OUT (default out/sanitize),
 #   CROWDSLAM_SANITIZE_BUILD_TYPE (default RelWithDebInfo), CROWDSLAM_SHARED (default ../shared),
@@ -39,6 +41,8 @@ shared="${CROWDSLAM_SHARED:-$root/../shared}"
 synth_frames="${CROWDSLAM_SANITIZE_FRAMES:-120}"
 bonn_frames="${CROWDSLAM_SANITIZE_BONN_FRAMES:-150}"
 bonn="$shared/data/bonn_crowd"
+euroc="$shared/data/euroc_v101_micro"
+kitti="$shared/data/kitti07_head"
 
 # Patterns of sanitizer reports (second line of defence besides the exit code).
 report_pattern='ERROR: AddressSanitizer|ERROR: LeakSanitizer|WARNING: ThreadSanitizer|runtime error:|SUMMARY: (Address|Thread|UndefinedBehavior|Leak)Sanitizer'
@@ -67,6 +71,25 @@ run_step() {
   fi
   log "$name: ok ($((end - start)) s)"
   summary+=("$name: ok ($((end - start)) s)")
+}
+
+# Runs a command in the background, sends SIGINT once its trajectory journal (DIR/CameraTrajectory.txt)
+# holds 40 poses, and succeeds when it exits with 130 and run.json says "interrupted".
+run_interrupted() {
+  local dir="$1"
+  shift
+  "$@" &
+  local pid=$! i
+  for ((i = 0; i < 6000; ++i)); do
+    if [[ -f "$dir/CameraTrajectory.txt" ]] && (($(grep -vc '^#' "$dir/CameraTrajectory.txt") >= 40)); then break; fi
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  kill -INT "$pid" 2>/dev/null || true
+  local rc=0
+  wait "$pid" || rc=$?
+  echo "exit code $rc"
+  [[ $rc -eq 130 ]] && grep -q '"end_state": "interrupted"' "$dir/run.json"
 }
 
 # TSan suppressions: third-party libraries only, each with the reason (docs/SANITIZERS.md).
@@ -138,24 +161,46 @@ run_sanitizer() {
     "$bin" synth --out "$seq" --frames "$synth_frames" --people 3 --trajectory handheld \
     --width 640 --height 480 --force || return 0
   run_step "$tag run synth (gt boxes)" "$out/run_gt.log" \
-    "$bin" run --dataset "$seq" --out "$out/run_gt" --detections "$seq/people_gt.txt" || true
+    "$bin" run --dataset "$seq" --out "$out/run_gt" --overwrite --detections "$seq/people_gt.txt" || true
   run_step "$tag run synth (detector)" "$out/run_detector.log" \
-    "$bin" run --dataset "$seq" --out "$out/run_detector" || true
+    "$bin" run --dataset "$seq" --out "$out/run_detector" --overwrite || true
   run_step "$tag run synth (no people filter)" "$out/run_nofilter.log" \
-    "$bin" run --dataset "$seq" --out "$out/run_nofilter" --no-people-filter || true
+    "$bin" run --dataset "$seq" --out "$out/run_nofilter" --overwrite --no-people-filter || true
   # Two laps with noisy depth: a loop is closed, so loop correction and the global-BA thread run.
   run_step "$tag synth (two laps)" "$out/synth_loop.log" \
     "$bin" synth --out "$out/loop_sequence" --frames 600 --noise-depth 0.05 --width 480 --height 360 --force ||
     return 0
   run_step "$tag run synth two laps (loop closing)" "$out/run_loop.log" \
-    "$bin" run --dataset "$out/loop_sequence" --out "$out/run_loop" --no-people-filter || true
+    "$bin" run --dataset "$out/loop_sequence" --out "$out/run_loop" --overwrite --no-people-filter || true
   if [[ -f "$bonn/rgb.txt" ]]; then
     run_step "$tag run bonn_crowd ($bonn_frames frames, depth filter)" "$out/run_bonn.log" \
       "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --filter-mode depth \
       --out "$out/run_bonn" || true
+    # Monocular on the same frames (two-view initialisation, monocular keyframe policy).
+    run_step "$tag run bonn_crowd mono ($bonn_frames frames)" "$out/run_bonn_mono.log" \
+      "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --sensor mono \
+      --allow-untracked --out "$out/run_bonn_mono" || true
+    # Interrupted mid-run: the signal path stops every thread at once and writes the outputs.
+    run_step "$tag run bonn_crowd interrupted (SIGINT)" "$out/run_interrupt.log" \
+      run_interrupted "$out/run_interrupt" "$bin" run --dataset "$bonn" --settings config/Bonn.yaml \
+      --out "$out/run_interrupt" || true
   else
-    log "$tag: $bonn not found, skipping the Bonn run"
+    log "$tag: $bonn not found, skipping the Bonn runs"
     summary+=("$tag run bonn_crowd: skipped (no data)")
+  fi
+  if [[ -d "$euroc/mav0" ]]; then
+    # Stereo: right-image ORB on its own thread, rectification from EuRoC's sensor.yaml.
+    run_step "$tag run euroc_v101_micro (stereo)" "$out/run_euroc.log" \
+      "$bin" run --dataset "$euroc" --settings config/EuRoC.yaml --out "$out/run_euroc" || true
+  else
+    summary+=("$tag run euroc stereo: skipped (no data)")
+  fi
+  if [[ -f "$kitti/times.txt" ]]; then
+    run_step "$tag run kitti07_head (mono)" "$out/run_kitti.log" \
+      "$bin" run --dataset "$kitti" --settings config/KITTI04-12.yaml --sensor mono --no-people-filter \
+      --allow-untracked --out "$out/run_kitti" || true
+  else
+    summary+=("$tag run kitti07_head mono: skipped (no data)")
   fi
 
   if ((run_ctest)); then

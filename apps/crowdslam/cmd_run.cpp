@@ -1,29 +1,63 @@
-// `crowdslam run`: SLAM over a sequence, with outputs in --out.
+// `crowdslam run`: SLAM over a sequence, with outputs in --out (kept as a journal while it runs).
 #include <spdlog/spdlog.h>
 
 #include <iostream>
 
 #include "commands.h"
 #include "crowdslam/io/dataset.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
+#include "crowdslam/util/interrupt.h"
 
 namespace crowdslam::app {
 
 namespace {
 struct RunArgs {
-  system::RunOptions options;
+  run::RunOptions options;
   std::string sensor;
   size_t frames = 0;
 };
+
+void print_summary(const run::RunSummary& summary) {
+  std::cout << "end state         " << summary.end.to_string() << "\n"
+            << "frames            " << summary.frames << "\n"
+            << "tracked           " << summary.tracked << " (" << summary.tracked_percent << " %)\n"
+            << "throughput        " << summary.throughput_fps << " frames/s\n"
+            << "tracking ms       median " << summary.tracking_ms_median << ", p95 " << summary.tracking_ms_p95 << "\n"
+            << "extraction ms     median " << summary.extraction_ms_median << "\n";
+  if (summary.init_frame) std::cout << "initialised at    frame " << *summary.init_frame << "\n";
+  if (summary.segments.size() > 1) {
+    std::cout << "maps              " << summary.segments.size() << " (the map was reset "
+              << summary.segments.size() - 1 << " times; every tracked frame is in CameraTrajectory.txt)\n";
+  }
+  if (summary.ate_rmse_m) {
+    std::cout << "ATE RMSE          " << *summary.ate_rmse_m << " m";
+    if (summary.segments.size() > 1 && summary.evaluated_map_id) {
+      size_t poses = 0;
+      for (const auto& a : summary.segment_accuracy) {
+        if (a.map_id == *summary.evaluated_map_id) poses = a.poses;
+      }
+      std::cout << " (map " << *summary.evaluated_map_id << ", the longest: " << poses << " of " << summary.tracked
+                << " poses; each map in run.json)";
+    }
+    std::cout << "\n";
+  }
+  const auto& accuracy = summary.json["accuracy"];
+  if (accuracy.is_object() && accuracy.contains("sim3_scale")) {
+    std::cout << "ATE alignment     sim3 (scale " << accuracy["sim3_scale"].get<double>() << ")\n";
+  }
+  if (summary.rpe_trans_rmse_m) std::cout << "RPE trans RMSE    " << *summary.rpe_trans_rmse_m << " m/s\n";
+  std::cout << "outputs           " << summary.out_dir << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json}\n";
+}
 }  // namespace
 
-void add_run_command(CLI::App& app, const GlobalOptions& global) {
+void add_run_command(CLI::App& app, GlobalOptions& global) {
   auto args = std::make_shared<RunArgs>();
   auto* cmd = app.add_subcommand("run", "Run SLAM on a dataset and write trajectories and statistics");
   cmd->add_option("--dataset,-d", args->options.dataset, "Dataset directory (TUM/Bonn, EuRoC, KITTI, images), video or camera index")
       ->required();
   cmd->add_option("--settings,-s", args->options.settings_path, "Settings YAML (default: DATASET/settings.yaml)");
-  cmd->add_option("--out,-o", args->options.out_dir, "Output directory")->required();
+  cmd->add_option("--out,-o", args->options.out_dir, "Output directory (new or empty; see --overwrite)")->required();
+  cmd->add_flag("--overwrite", args->options.overwrite, "Replace an earlier run's outputs in --out");
   cmd->add_option("--sensor", args->sensor, "Override the sensor detected from the dataset: rgbd, stereo or mono (mono: the colour / left images only)");
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
@@ -41,31 +75,24 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "'none' relocalises by brute-force matching");
   cmd->add_flag("!--no-loop-closing", args->options.loop_closing,
                 "Run without the loop closing thread (no place recognition, no pose-graph or global BA)");
+  cmd->add_flag("--skip-bad-frames", args->options.skip_bad_frames,
+                "Skip (count and warn about) frames that cannot be read instead of failing the run");
+  cmd->add_flag("--allow-untracked", args->options.allow_untracked,
+                "Exit 0 even when no frame could be tracked");
   cmd->callback([args, &global] {
     if (!args->sensor.empty()) args->options.sensor = io::parse_sensor_kind(args->sensor, "--sensor");
     args->options.max_frames = args->frames;
     args->options.progress = !global.quiet;
-    const auto summary = system::run_sequence(args->options);
+    InterruptScope interrupts;  // Ctrl-C / SIGTERM / SIGHUP stop the run and write its outputs
+    const auto summary = run::run_sequence(args->options);
     if (global.json) {
       auto doc = summary.json;
       doc.erase("frames");
       print_json(doc);
-      return;
+    } else {
+      print_summary(summary);
     }
-    std::cout << "frames            " << summary.frames << "\n"
-              << "tracked           " << summary.tracked << " (" << summary.tracked_percent << " %)\n"
-              << "throughput        " << summary.throughput_fps << " frames/s\n"
-              << "tracking ms       median " << summary.tracking_ms_median << ", p95 " << summary.tracking_ms_p95
-              << "\n"
-              << "extraction ms     median " << summary.extraction_ms_median << "\n";
-    if (summary.init_frame) std::cout << "initialised at    frame " << *summary.init_frame << "\n";
-    if (summary.ate_rmse_m) std::cout << "ATE RMSE          " << *summary.ate_rmse_m << " m\n";
-    const auto& accuracy = summary.json["accuracy"];
-    if (accuracy.is_object() && accuracy.contains("sim3_scale")) {
-      std::cout << "ATE alignment     sim3 (scale " << accuracy["sim3_scale"].get<double>() << ")\n";
-    }
-    if (summary.rpe_trans_rmse_m) std::cout << "RPE trans RMSE    " << *summary.rpe_trans_rmse_m << " m/s\n";
-    std::cout << "outputs           " << args->options.out_dir << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json}\n";
+    if (summary.end.kind == system::EndState::Kind::kInterrupted) global.exit_code = 128 + summary.end.signal;
   });
 }
 

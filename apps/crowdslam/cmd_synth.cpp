@@ -7,10 +7,11 @@
 
 #include "commands.h"
 #include "crowdslam/synth/writer.h"
+#include "crowdslam/util/interrupt.h"
 
 namespace crowdslam::app {
 
-void add_synth_command(CLI::App& app, const GlobalOptions& global) {
+void add_synth_command(CLI::App& app, GlobalOptions& global) {
   struct Args {
     std::string out;
     std::string trajectory = "loop";
@@ -35,6 +36,7 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--force", args->options.force, "Replace an existing non-empty output directory");
   cmd->callback([args, &global] {
     args->options.trajectory = synth::parse_trajectory_kind(args->trajectory);
+    InterruptScope interrupts;  // a signal stops the rendering and removes the unfinished output
     const synth::SequenceSummary s = synth::write_sequence(args->options, args->out);
     if (global.json) {
       nlohmann::json j{{"out", args->out},

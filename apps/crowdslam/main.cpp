@@ -1,19 +1,52 @@
 // crowdslam: visual SLAM that keeps working in crowds. Command-line entry point.
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <filesystem>
 #include <iostream>
+#include <new>
 
 #include "commands.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/interrupt.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::app {
-void print_json(const nlohmann::json& document) { std::cout << document.dump(2) << '\n'; }
+namespace {
+bool g_json_printed = false;
+}
+void print_json(const nlohmann::json& document) {
+  std::cout << document.dump(2) << '\n';
+  g_json_printed = true;
+}
 }  // namespace crowdslam::app
+
+namespace {
+// One line on stderr; with --json also one JSON document on stdout, unless the command printed its own.
+int fail(const crowdslam::app::GlobalOptions& global, const std::string& message, int code) {
+  std::cerr << "error: " << message << '\n';
+  if (global.json && !crowdslam::app::g_json_printed) {
+    crowdslam::app::print_json({{"error", message}, {"exit_code", code}});
+  }
+  return code;
+}
+
+// A filesystem error names its paths; they can be huge (a 2 MB name): clipped.
+std::string filesystem_message(const std::filesystem::filesystem_error& e) {
+  std::string message;
+  if (!e.path1().empty()) message += crowdslam::clip_text(e.path1().string(), 200) + ": ";
+  if (!e.path2().empty()) message += crowdslam::clip_text(e.path2().string(), 200) + ": ";
+  return message + e.code().message();
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace crowdslam::app;
+  // Logs and progress on stderr, so stdout holds only results (and --json exactly one document).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("crowdslam"));
+  crowdslam::install_cleanup_handlers();  // a signal never leaves a temporary file behind
   CLI::App app{"crowdslam: visual SLAM that keeps working in crowds"};
   app.set_version_flag("--version", std::string("crowdslam ") + CROWDSLAM_VERSION);
   app.require_subcommand(1);
@@ -40,12 +73,17 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const crowdslam::Interrupted& e) {
+    return fail(global, e.what(), e.exit_code());
   } catch (const crowdslam::InputError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 1;
+    return fail(global, e.what(), 1);
+  } catch (const std::filesystem::filesystem_error& e) {
+    return fail(global, filesystem_message(e), 1);
+  } catch (const std::bad_alloc&) {
+    return fail(global, "out of memory", 2);
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
+    return fail(global, crowdslam::clip_text(e.what(), 1000), 2);
   }
-  return 0;
+  spdlog::default_logger()->flush();
+  return global.exit_code;
 }

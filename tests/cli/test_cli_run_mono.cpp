@@ -34,10 +34,14 @@ nlohmann::json read_run_json(const std::filesystem::path& out) {
 }
 
 void expect_never_initialised(const std::filesystem::path& seq, const std::filesystem::path& out) {
+  // A run that tracks nothing is an error unless --allow-untracked.
+  const auto refused = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string() + "_refused", "--sensor",
+                                "mono", "--no-people-filter", "--sequential", "--vocabulary", "none"});
+  EXPECT_EQ(refused.exit_code, 1) << refused.err;
   const auto r = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sensor", "mono",
-                          "--no-people-filter", "--sequential", "--vocabulary", "none"});
+                          "--no-people-filter", "--sequential", "--vocabulary", "none", "--allow-untracked"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string log = r.out + r.err;  // spdlog writes to stdout
+  const std::string log = r.err;  // logs go to stderr
   EXPECT_NE(log.find("never initialised"), std::string::npos) << log;
   const auto doc = read_run_json(out);
   EXPECT_EQ(doc["sensor"], "monocular");

@@ -1,5 +1,6 @@
 // `crowdslam run` with stereo: sensor mismatches, unrectified input, a missing or mis-sized right image.
-// Each is one line on stderr naming the problem, exit code 1, and no output directory.
+// Each is one line on stderr naming the problem, exit code 1, and no output directory (a bad right image
+// in the middle of the sequence keeps the frames before it).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -64,12 +65,16 @@ TEST(CliRunStereo, MissingOrMisSizedRightImageIsAClearError) {
   TempDir dir;
   const auto stereo = synth(dir, "stereo", true);
   const auto out = dir / "out";
-  // A right image of another size in the middle of the sequence.
+  // A right image of another size in the middle of the sequence: an error naming it, after the frames
+  // before it were tracked and written (run.json says "failed").
   const auto victim = stereo / "image_1" / "000003.png";
   cv::imwrite(victim.string(), cv::Mat(120, 160, CV_8UC3, cv::Scalar(0, 0, 0)));
-  expect_clean_failure(run_cli({"-q", "run", "--dataset", stereo.string(), "--out", out.string(), "--no-people-filter"}),
-                       out, "000003.png");
-  // A missing right image.
+  const auto mid = run_cli({"-q", "run", "--dataset", stereo.string(), "--out", out.string(), "--no-people-filter"});
+  EXPECT_EQ(mid.exit_code, 1);
+  EXPECT_NE(mid.err.find("image_1/000003.png"), std::string::npos) << mid.err;
+  EXPECT_NE(crowdslam::test::read_text(out / "run.json").find("\"end_state\": \"failed: "), std::string::npos);
+  std::filesystem::remove_all(out);
+  // A missing right image: found when the dataset is opened, before any output.
   std::filesystem::remove(victim);
   expect_clean_failure(run_cli({"-q", "run", "--dataset", stereo.string(), "--out", out.string(), "--no-people-filter"}),
                        out, "000003.png");

@@ -1,9 +1,13 @@
 #include "test_support.h"
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -81,6 +85,79 @@ CliResult run_cli(const std::vector<std::string>& args) {
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = read_text(out_path);
   result.err = read_text(err_path);
+  return result;
+}
+
+namespace {
+[[noreturn]] void exec_cli(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  std::string program = CROWDSLAM_CLI_PATH;
+  argv.push_back(program.data());
+  std::vector<std::string> copy = args;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  ::execv(program.c_str(), argv.data());
+  _exit(127);
+}
+}  // namespace
+
+CliProcess::CliProcess(const std::vector<std::string>& args, const ChildLimits& limits) {
+  const auto out_path = tmp_ / "stdout";
+  const auto err_path = tmp_ / "stderr";
+  std::fflush(nullptr);
+  pid_ = ::fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ == 0) {
+    if (!std::freopen(out_path.c_str(), "w", stdout) || !std::freopen(err_path.c_str(), "w", stderr)) _exit(127);
+    if (limits.max_file_bytes >= 0) {
+      std::signal(SIGXFSZ, SIG_IGN);  // the write fails with EFBIG instead of killing the process
+      struct rlimit limit {};
+      limit.rlim_cur = static_cast<rlim_t>(limits.max_file_bytes);
+      limit.rlim_max = static_cast<rlim_t>(limits.max_file_bytes);
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
+    }
+    // The test runner may block or ignore signals; the child starts with the defaults.
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, SIG_DFL);
+    exec_cli(args);
+  }
+}
+
+CliProcess::~CliProcess() {
+  if (pid_ > 0 && !reaped_) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, &status_, 0);
+  }
+}
+
+void CliProcess::send_signal(int signal) const { ::kill(pid_, signal); }
+
+void CliProcess::sleep_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
+
+bool CliProcess::exited() {
+  if (reaped_) return true;
+  if (::waitpid(pid_, &status_, WNOHANG) == pid_) reaped_ = true;
+  return reaped_;
+}
+
+std::string CliProcess::current_stderr() const { return read_text(tmp_ / "stderr"); }
+
+CliResult CliProcess::wait(double timeout_s) {
+  CliResult result;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!exited() && std::chrono::steady_clock::now() < deadline) sleep_ms(5);
+  if (!reaped_) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, &status_, 0);
+    reaped_ = true;
+    result.exit_code = -1;
+  } else {
+    result.exit_code = WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
+  }
+  result.out = read_text(tmp_ / "stdout");
+  result.err = read_text(tmp_ / "stderr");
   return result;
 }
 

@@ -43,6 +43,45 @@ struct CliResult {
 // Runs the built `crowdslam` binary with the given arguments (no shell quoting needed).
 CliResult run_cli(const std::vector<std::string>& args);
 
+// Limits for a child process (setrlimit in the child before exec).
+struct ChildLimits {
+  long long max_file_bytes = -1;  // RLIMIT_FSIZE (writes beyond fail with EFBIG; SIGXFSZ ignored); -1 = none
+};
+
+// The `crowdslam` binary as a child process that a test can signal while it runs. stdout and stderr go
+// to files in a temporary directory; the destructor kills (SIGKILL) and reaps a child still running.
+class CliProcess {
+ public:
+  explicit CliProcess(const std::vector<std::string>& args, const ChildLimits& limits = {});
+  ~CliProcess();
+  CliProcess(const CliProcess&) = delete;
+  CliProcess& operator=(const CliProcess&) = delete;
+
+  void send_signal(int signal) const;
+  // Waits until `predicate()` is true or the child exits or `timeout_s` passes; returns predicate().
+  template <typename P>
+  bool wait_until(P&& predicate, double timeout_s) {
+    for (int i = 0; i < static_cast<int>(timeout_s * 200); ++i) {
+      if (predicate()) return true;
+      if (exited()) return predicate();
+      sleep_ms(5);
+    }
+    return predicate();
+  }
+  // Waits for the child to exit (up to timeout_s; then kills it and fails the result with exit -1).
+  CliResult wait(double timeout_s = 600);
+  [[nodiscard]] bool exited();
+  [[nodiscard]] std::string current_stderr() const;
+  [[nodiscard]] int pid() const { return pid_; }
+
+ private:
+  static void sleep_ms(int ms);
+  TempDir tmp_;
+  int pid_ = -1;
+  bool reaped_ = false;
+  int status_ = 0;
+};
+
 // The message of the InputError that f() throws, or "" when it throws none.
 template <typename F>
 std::string error_of(F&& f) {

@@ -12,16 +12,16 @@
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
 #include "test_support.h"
 
 using namespace crowdslam;
 
 namespace {
 
-system::RunSummary run(const std::filesystem::path& dataset, const std::filesystem::path& out, bool loop_closing,
+run::RunSummary run_slam(const std::filesystem::path& dataset, const std::filesystem::path& out, bool loop_closing,
                        size_t max_frames = 0) {
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = dataset.string();
   options.out_dir = out.string();
   options.sequential = true;
@@ -29,7 +29,7 @@ system::RunSummary run(const std::filesystem::path& dataset, const std::filesyst
   options.people_filter = false;
   options.loop_closing = loop_closing;
   options.max_frames = max_frames;
-  return system::run_sequence(options);
+  return run::run_sequence(options);
 }
 
 // Ground-truth pose at a timestamp (exact: the generator writes one pose per frame).
@@ -57,8 +57,8 @@ TEST(LoopClosing, TwoLapsWithDepthNoiseLoopFoundAndAteHalved) {
   const auto dataset = tmp / "loop";
   synth::write_sequence(synth_options, dataset);
 
-  const auto without = run(dataset, tmp / "without", false);
-  const auto with = run(dataset, tmp / "with", true);
+  const auto without = run_slam(dataset, tmp / "without", false);
+  const auto with = run_slam(dataset, tmp / "with", true);
   ASSERT_TRUE(without.ate_rmse_m && with.ate_rmse_m);
   EXPECT_EQ(with.tracked, 600u);
   const auto& loops = with.json["loop_closing"]["loops"];
@@ -88,6 +88,6 @@ TEST(LoopClosing, TwoLapsWithDepthNoiseLoopFoundAndAteHalved) {
   }
 
   // No loop while nothing is revisited (first quarter of the first lap).
-  const auto quarter = run(dataset, tmp / "quarter", true, 150);
+  const auto quarter = run_slam(dataset, tmp / "quarter", true, 150);
   EXPECT_EQ(quarter.json["loop_closing"]["loops"].size(), 0u);
 }

@@ -22,7 +22,7 @@
 #include "crowdslam/io/associate.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/io/tum_dataset.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -103,14 +103,14 @@ TEST(RelocalizationBonn, JumpBackIsRelocalisedWithinFiveFramesAndFiveCentimetres
   ASSERT_GT(gt.size(), 450u);
 
   // As the Bonn end-to-end test: default options (people filter), sequential for reproducibility.
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = dataset.string();
   options.settings_path = (test::source_dir() / "config" / "Bonn.yaml").string();
   options.out_dir = (tmp / "out").string();
   options.sequential = true;
   options.progress = false;
   options.vocabulary = vocabulary;
-  const auto summary = system::run_sequence(options);
+  const auto summary = run::run_sequence(options);
   ASSERT_EQ(summary.frames, kReturn + kSecondPart);
 
   const auto doc = nlohmann::json::parse(test::read_text(tmp / "out" / "run.json"));

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdslam/io/trajectory.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
 #include "crowdslam/util/error.h"
 #include "test_support.h"
 
@@ -14,14 +14,14 @@ using namespace crowdslam;
 TEST(RunBonn, First200FramesTrackedAccurately) {
   CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
   test::TempDir out;
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = test::shared_data("bonn_crowd").string();
   options.settings_path = (test::source_dir() / "config" / "Bonn.yaml").string();
   options.out_dir = (out / "run").string();
   options.sequential = true;
   options.max_frames = 200;
   options.progress = false;
-  const auto summary = system::run_sequence(options);
+  const auto summary = run::run_sequence(options);
 
   EXPECT_EQ(summary.frames, 200u);
   EXPECT_GE(summary.tracked_percent, 95.0);
@@ -44,12 +44,12 @@ TEST(RunBonn, First200FramesTrackedAccurately) {
 TEST(RunBonn, MissingSettingsIsAClearErrorAndWritesNothing) {
   CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
   test::TempDir out;
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = test::shared_data("bonn_crowd").string();
   options.settings_path = (out / "nope.yaml").string();
   options.out_dir = (out / "run").string();
   try {
-    system::run_sequence(options);
+    run::run_sequence(options);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("nope.yaml"), std::string::npos);

@@ -4,7 +4,7 @@
 
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -21,7 +21,7 @@ TEST(RunMonocular, SweepWithPeopleInitialisesEarlyAndTracksWithSim3AccuracyUnder
   const auto dataset = tmp / "sweep";
   synth::write_sequence(synth_options, dataset);
 
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = dataset.string();
   options.out_dir = (tmp / "out").string();
   options.sensor = io::SensorKind::kMonocular;
@@ -29,7 +29,7 @@ TEST(RunMonocular, SweepWithPeopleInitialisesEarlyAndTracksWithSim3AccuracyUnder
   options.progress = false;
   options.detections_file = (dataset / "people_gt.txt").string();
   options.vocabulary = "none";
-  const auto summary = system::run_sequence(options);
+  const auto summary = run::run_sequence(options);
 
   EXPECT_EQ(summary.json["sensor"], "monocular");
   ASSERT_TRUE(summary.init_frame.has_value());

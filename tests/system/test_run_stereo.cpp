@@ -9,7 +9,7 @@
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
 #include "crowdslam/system/system.h"
 #include "test_support.h"
 
@@ -25,13 +25,13 @@ TEST(RunStereo, SyntheticStereoSequenceTrackedWithinOneCentimetre) {
   synth_options.stereo = true;
   synth::write_sequence(synth_options, tmp / "seq");
 
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = (tmp / "seq").string();  // sensor detected: KITTI layout with image_1
   options.out_dir = (tmp / "out").string();
   options.sequential = true;
   options.progress = false;
   options.people_filter = false;
-  const auto summary = system::run_sequence(options);
+  const auto summary = run::run_sequence(options);
   EXPECT_EQ(summary.json["sensor"].get<std::string>(), "stereo");
   EXPECT_EQ(summary.frames, 90u);
   EXPECT_EQ(summary.tracked, 90u);  // initialised from the first pair, like RGB-D
@@ -47,15 +47,15 @@ TEST(RunStereo, SyntheticStereoSequenceTrackedWithinOneCentimetre) {
 }
 
 namespace {
-system::RunSummary run_euroc(const test::TempDir& tmp, const std::string& settings, bool people_filter) {
-  system::RunOptions options;
+run::RunSummary run_euroc(const test::TempDir& tmp, const std::string& settings, bool people_filter) {
+  run::RunOptions options;
   options.dataset = test::shared_data("euroc_v101_micro").string();
   options.settings_path = settings;
   options.out_dir = (tmp / "out").string();
   options.sequential = true;
   options.progress = false;
   options.people_filter = people_filter;
-  return system::run_sequence(options);
+  return run::run_sequence(options);
 }
 }  // namespace
 

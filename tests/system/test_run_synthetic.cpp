@@ -3,7 +3,7 @@
 
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
-#include "crowdslam/system/run_sequence.h"
+#include "crowdslam/run/run_sequence.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -20,23 +20,23 @@ std::filesystem::path make_sequence(const test::TempDir& tmp, int people) {
   return dir;
 }
 
-system::RunSummary run(const std::filesystem::path& dataset, const std::filesystem::path& out, bool filter,
+run::RunSummary run_slam(const std::filesystem::path& dataset, const std::filesystem::path& out, bool filter,
                        const std::string& detections = "") {
-  system::RunOptions options;
+  run::RunOptions options;
   options.dataset = dataset.string();
   options.out_dir = out.string();
   options.sequential = true;
   options.progress = false;
   options.people_filter = filter;
   options.detections_file = detections;
-  return system::run_sequence(options);
+  return run::run_sequence(options);
 }
 }  // namespace
 
 TEST(RunSynthetic, StaticSceneTrackedWithMillimetreAccuracy) {
   test::TempDir tmp;
   const auto dataset = make_sequence(tmp, 0);
-  const auto summary = run(dataset, tmp / "out", false);
+  const auto summary = run_slam(dataset, tmp / "out", false);
   EXPECT_EQ(summary.frames, 150u);
   EXPECT_EQ(summary.tracked, 150u);
   ASSERT_TRUE(summary.ate_rmse_m.has_value());
@@ -46,7 +46,7 @@ TEST(RunSynthetic, StaticSceneTrackedWithMillimetreAccuracy) {
 TEST(RunSynthetic, PeopleFilterWithGroundTruthBoxesRemovesKeypointsOnPeople) {
   test::TempDir tmp;
   const auto dataset = make_sequence(tmp, 3);
-  const auto filtered = run(dataset, tmp / "filtered", true, (dataset / "people_gt.txt").string());
+  const auto filtered = run_slam(dataset, tmp / "filtered", true, (dataset / "people_gt.txt").string());
   EXPECT_EQ(filtered.tracked, 150u);
   ASSERT_TRUE(filtered.ate_rmse_m.has_value());
   EXPECT_LT(*filtered.ate_rmse_m, 0.005);

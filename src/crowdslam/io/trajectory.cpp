@@ -205,42 +205,65 @@ Trajectory read_trajectory(const std::string& path) {
   return read_tum_trajectory(path);
 }
 
-void write_tum_trajectory(const std::string& path, const Trajectory& trajectory) {
-  AtomicFile file(path);
-  file.stream() << "# timestamp tx ty tz qx qy qz qw\n";
-  for (const StampedPose& pose : trajectory) {
-    const Vec3& t = pose.world_from_cam.translation();
-    const Eigen::Quaterniond q = pose.world_from_cam.rotation().normalized();
-    file.stream() << format_line("%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", pose.timestamp_s, t.x(), t.y(),
-                                 t.z(), q.x(), q.y(), q.z(), q.w());
+TrajectoryFormat parse_trajectory_format(const std::string& name) {
+  if (name == "kitti") return TrajectoryFormat::kKitti;
+  if (name == "euroc") return TrajectoryFormat::kEuroc;
+  return TrajectoryFormat::kTum;
+}
+
+std::string trajectory_header(TrajectoryFormat format) {
+  switch (format) {
+    case TrajectoryFormat::kTum:
+      return "# timestamp tx ty tz qx qy qz qw\n";
+    case TrajectoryFormat::kKitti:
+      return "";
+    case TrajectoryFormat::kEuroc:
+      return "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
   }
+  return "";
+}
+
+std::string format_trajectory_line(const StampedPose& pose, TrajectoryFormat format) {
+  const Vec3& t = pose.world_from_cam.translation();
+  switch (format) {
+    case TrajectoryFormat::kKitti: {
+      const Mat3 r = pose.world_from_cam.rotation_matrix();
+      return format_line("%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", r(0, 0), r(0, 1), r(0, 2),
+                         t(0), r(1, 0), r(1, 1), r(1, 2), t(1), r(2, 0), r(2, 1), r(2, 2), t(2));
+    }
+    case TrajectoryFormat::kEuroc: {
+      const Eigen::Quaterniond q = pose.world_from_cam.rotation().normalized();
+      const long long stamp_ns = std::llround(pose.timestamp_s * 1e9);
+      return format_line("%lld,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", stamp_ns, t.x(), t.y(), t.z(), q.w(), q.x(),
+                         q.y(), q.z());
+    }
+    case TrajectoryFormat::kTum:
+      break;
+  }
+  const Eigen::Quaterniond q = pose.world_from_cam.rotation().normalized();
+  return format_line("%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", pose.timestamp_s, t.x(), t.y(), t.z(), q.x(),
+                     q.y(), q.z(), q.w());
+}
+
+namespace {
+void write_formatted(const std::string& path, const Trajectory& trajectory, TrajectoryFormat format) {
+  AtomicFile file(path);
+  file.stream() << trajectory_header(format);
+  for (const StampedPose& pose : trajectory) file.stream() << format_trajectory_line(pose, format);
   file.commit();
+}
+}  // namespace
+
+void write_tum_trajectory(const std::string& path, const Trajectory& trajectory) {
+  write_formatted(path, trajectory, TrajectoryFormat::kTum);
 }
 
 void write_kitti_trajectory(const std::string& path, const Trajectory& trajectory) {
-  AtomicFile file(path);
-  for (const StampedPose& pose : trajectory) {
-    const Mat3 r = pose.world_from_cam.rotation_matrix();
-    const Vec3& t = pose.world_from_cam.translation();
-    file.stream() << format_line("%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", r(0, 0),
-                                 r(0, 1), r(0, 2), t(0), r(1, 0), r(1, 1), r(1, 2), t(1), r(2, 0), r(2, 1),
-                                 r(2, 2), t(2));
-  }
-  file.commit();
+  write_formatted(path, trajectory, TrajectoryFormat::kKitti);
 }
 
 void write_euroc_trajectory(const std::string& path, const Trajectory& trajectory) {
-  AtomicFile file(path);
-  file.stream() << "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],"
-                   "q_RS_z []\n";
-  for (const StampedPose& pose : trajectory) {
-    const Vec3& t = pose.world_from_cam.translation();
-    const Eigen::Quaterniond q = pose.world_from_cam.rotation().normalized();
-    const long long stamp_ns = std::llround(pose.timestamp_s * 1e9);
-    file.stream() << format_line("%lld,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", stamp_ns, t.x(), t.y(), t.z(),
-                                 q.w(), q.x(), q.y(), q.z());
-  }
-  file.commit();
+  write_formatted(path, trajectory, TrajectoryFormat::kEuroc);
 }
 
 void write_trajectory(const std::string& path, const Trajectory& trajectory, TrajectoryFormat format) {

@@ -38,5 +38,11 @@ void write_tum_trajectory(const std::string& path, const Trajectory& trajectory)
 void write_kitti_trajectory(const std::string& path, const Trajectory& trajectory);
 void write_euroc_trajectory(const std::string& path, const Trajectory& trajectory);
 void write_trajectory(const std::string& path, const Trajectory& trajectory, TrajectoryFormat format);
+// The pieces the writers use, for files written line by line (the run's trajectory journal): the header
+// ("" for KITTI) and one newline-terminated line per pose.
+std::string trajectory_header(TrajectoryFormat format);
+std::string format_trajectory_line(const StampedPose& pose, TrajectoryFormat format);
+// "tum" | "kitti" | "euroc" (anything else: TUM).
+TrajectoryFormat parse_trajectory_format(const std::string& name);
 
 }  // namespace crowdslam::io

@@ -61,6 +61,17 @@ void LoopCloser::stop() {
   global_ba_.wait();
 }
 
+void LoopCloser::stop_now() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    stop_requested_ = true;
+    queue_.clear();
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();  // after a correction in progress, which may launch global BA
+  global_ba_.abort();
+}
+
 void LoopCloser::run() {
   while (true) {
     std::shared_ptr<map::KeyFrame> keyframe;

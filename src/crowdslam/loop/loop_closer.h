@@ -74,6 +74,8 @@ class LoopCloser {
   void start();
   // Finishes the queued keyframes, waits for a running global BA, stops the thread (idempotent).
   void stop();
+  // Drops the queue, lets a loop correction in progress finish, aborts global BA, stops (interrupts).
+  void stop_now();
   // Sequential mode: processes the queue on the caller's thread (global BA inline too).
   void process_all();
   void insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe);

@@ -51,6 +51,21 @@ void LocalMapper::stop() {
   if (worker_.joinable()) worker_.join();
 }
 
+void LocalMapper::stop_now() {
+  size_t dropped = 0;
+  {
+    std::lock_guard lock(queue_mutex_);
+    stop_requested_ = true;
+    stopping_now_ = true;
+    dropped = queue_.size();
+    queue_.clear();
+    abort_ba_ = true;
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  if (dropped > 0) spdlog::info("local mapping stopped: {} queued keyframes not processed", dropped);
+}
+
 void LocalMapper::run() {
   while (true) {
     std::shared_ptr<map::KeyFrame> keyframe;
@@ -160,7 +175,7 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
   const double fusion_ms = ms_since(t);
   abort_ba_ = false;
   double culling_ms = 0;
-  if (!has_new_keyframes() && !pause_requested_) {
+  if (!has_new_keyframes() && !pause_requested_ && !stopping_now_) {
     if (options_.local_ba && map_->num_keyframes() > 2) run_local_bundle_adjustment(keyframe);
     t = Clock::now();
     cull_keyframes(keyframe);

@@ -68,6 +68,9 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   void start();
   // Finishes the queued keyframes, then stops the worker (idempotent).
   void stop();
+  // Drops the queued keyframes, aborts a running local BA (nothing of it is applied) and stops the worker
+  // after the keyframe it is on (interrupts).
+  void stop_now();
 
   // Sequential mode: processes every queued keyframe on the caller's thread.
   void process_all();
@@ -125,6 +128,7 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done_;
   std::atomic<bool> accepting_{true};
   std::atomic<bool> abort_ba_{false};
+  std::atomic<bool> stopping_now_{false};  // stop_now(): no new local BA
   std::thread worker_;
 
   // Owned by the mapping thread (or the caller in sequential mode).

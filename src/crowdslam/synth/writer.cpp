@@ -17,6 +17,7 @@
 
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/util/atomic_file.h"
+#include "crowdslam/util/interrupt.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::synth {
@@ -101,6 +102,7 @@ class SequenceWriter {
       const int frame = next_++;
       if (frame >= scene_.frame_count()) return;
       try {
+        throw_if_interrupted();  // `crowdslam synth` inside an InterruptScope
         write_frame(frame);
       } catch (...) {
         const std::lock_guard<std::mutex> lock(mutex_);

@@ -263,6 +263,34 @@ void System::shutdown() {
   if (loop_closer_) loop_closer_->stop();  // after the mapper: it may still hand over keyframes
 }
 
+void System::stop_now() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  mapper_->stop_now();
+  if (loop_closer_) loop_closer_->stop_now();
+}
+
+void System::finish(const EndState& end) {
+  if (end.completed()) {
+    shutdown();
+  } else {
+    stop_now();
+  }
+  for (auto* observer : observers_) observer->on_finish(end);
+}
+
+std::string EndState::to_string() const {
+  switch (kind) {
+    case Kind::kCompleted:
+      return "completed";
+    case Kind::kInterrupted:
+      return "interrupted";
+    case Kind::kFailed:
+      return "failed: " + reason;
+  }
+  return "failed: " + reason;
+}
+
 FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   FrameReport report;
   report.index = next_frame_id_;
@@ -346,12 +374,28 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
 
   TrajectoryRecord record;
   record.timestamp_s = timestamp_s;
+  record.segment = map_resets_;
+  std::optional<geometry::SE3> world_from_cam;
   if (result.state == tracking::TrackingState::kOk && result.cam_from_world && result.reference_keyframe) {
     record.reference = result.reference_keyframe;
     record.cam_from_reference = *result.cam_from_world * result.reference_keyframe->world_from_cam();
+    record.world_from_cam = result.cam_from_world->inverse();
     record.tracked = true;
+    world_from_cam = record.world_from_cam;
+  }
+  if (segments_.empty()) segments_.push_back(MapSegment{0, report.index, report.index, 0, 0, 0, 0, 0});
+  MapSegment& segment = segments_.back();
+  segment.last_frame = report.index;
+  ++segment.frames;
+  if (record.tracked) {
+    if (segment.tracked++ == 0) segment.first_stamp_s = timestamp_s;
+    segment.last_stamp_s = timestamp_s;
   }
   records_.push_back(std::move(record));
+  for (auto* observer : observers_) observer->on_frame(report, world_from_cam, images);
+  if (result.new_keyframe && result.reference_keyframe) {  // a new keyframe becomes the reference
+    for (auto* observer : observers_) observer->on_keyframe(result.reference_keyframe->id);
+  }
   if (result.map_reset) reset_map();
   return report;
 }
@@ -365,11 +409,21 @@ void System::reset_map() {
     loop_closer_->reset();
   }
   mapper_->reset();
-  // Frames tracked against the discarded map live in another coordinate frame: drop them.
+  // Frames tracked against the discarded map keep the poses that map gave them (its own coordinate
+  // frame, listed as a segment); only the links into the map are cut.
   for (auto& r : records_) {
-    r.tracked = false;
+    if (!r.reference) continue;
+    r.world_from_cam = world_from_cam(r);
     r.reference.reset();
   }
+  const io::Trajectory keyframes = live_keyframe_trajectory();
+  past_keyframes_.insert(past_keyframes_.end(), keyframes.begin(), keyframes.end());
+  MapSegment ended = segments_.back();
+  ended.keyframes = keyframes.size();
+  segments_.back() = ended;
+  segments_.push_back(MapSegment{map_resets_, next_frame_id_, next_frame_id_, 0, 0, 0, 0, 0});
+  segments_.back().frames = 0;
+  for (auto* observer : observers_) observer->on_reset(ended);
   if (keyframe_database_) keyframe_database_->clear();
   map_->clear();
   tracker_->reset();
@@ -377,31 +431,60 @@ void System::reset_map() {
   if (threaded && loop_closer_) loop_closer_->start();
 }
 
+geometry::SE3 System::world_from_cam(const TrajectoryRecord& r) const {
+  if (!r.reference) return r.world_from_cam;
+  // A culled reference keyframe is replaced by its parent, accumulating the relative pose.
+  geometry::SE3 cam_from_keyframe = r.cam_from_reference;
+  std::shared_ptr<map::KeyFrame> keyframe = r.reference;
+  int guard = 0;
+  while (keyframe && keyframe->is_bad() && guard++ < 100000) {
+    cam_from_keyframe = cam_from_keyframe * keyframe->cam_from_parent_at_erase();
+    keyframe = keyframe->parent();
+  }
+  if (!keyframe) return r.world_from_cam;  // no surviving ancestor: the pose tracking gave it
+  return (cam_from_keyframe * keyframe->cam_from_world()).inverse();
+}
+
+std::vector<io::Trajectory> System::camera_trajectory_segments() const {
+  std::vector<io::Trajectory> trajectories(std::max<size_t>(1, segments_.size()));
+  for (const auto& r : records_) {
+    if (!r.tracked) continue;
+    trajectories[static_cast<size_t>(r.segment)].push_back({r.timestamp_s, world_from_cam(r)});
+  }
+  return trajectories;
+}
+
 io::Trajectory System::camera_trajectory() const {
   io::Trajectory trajectory;
   for (const auto& r : records_) {
-    if (!r.tracked) continue;
-    // A culled reference keyframe is replaced by its parent, accumulating the relative pose.
-    geometry::SE3 cam_from_keyframe = r.cam_from_reference;
-    std::shared_ptr<map::KeyFrame> keyframe = r.reference;
-    int guard = 0;
-    while (keyframe && keyframe->is_bad() && guard++ < 100000) {
-      cam_from_keyframe = cam_from_keyframe * keyframe->cam_from_parent_at_erase();
-      keyframe = keyframe->parent();
-    }
-    if (!keyframe) continue;
-    const geometry::SE3 cam_from_world = cam_from_keyframe * keyframe->cam_from_world();
-    trajectory.push_back({r.timestamp_s, cam_from_world.inverse()});
+    if (r.tracked) trajectory.push_back({r.timestamp_s, world_from_cam(r)});
   }
   return trajectory;
 }
 
-io::Trajectory System::keyframe_trajectory() const {
+size_t System::tracked_frames() const {
+  return static_cast<size_t>(std::count_if(records_.begin(), records_.end(), [](const auto& r) { return r.tracked; }));
+}
+
+std::vector<MapSegment> System::segments() const {
+  std::vector<MapSegment> result = segments_;
+  if (!result.empty()) result.back().keyframes = live_keyframe_trajectory().size();
+  return result;
+}
+
+io::Trajectory System::live_keyframe_trajectory() const {
   io::Trajectory trajectory;
   for (const auto& kf : map_->keyframes()) {
     if (kf->is_bad()) continue;
     trajectory.push_back({kf->timestamp_s, kf->world_from_cam()});
   }
+  return trajectory;
+}
+
+io::Trajectory System::keyframe_trajectory() const {
+  io::Trajectory trajectory = past_keyframes_;
+  const io::Trajectory live = live_keyframe_trajectory();
+  trajectory.insert(trajectory.end(), live.begin(), live.end());
   return trajectory;
 }
 

@@ -15,6 +15,7 @@
 #include "crowdslam/people/detection_worker.h"
 #include "crowdslam/people/feature_budget.h"
 #include "crowdslam/people/keypoint_filter.h"
+#include "crowdslam/system/run_observer.h"
 #include "crowdslam/system/stereo_rectifier.h"
 #include "crowdslam/tracking/frame_builder.h"
 #include "crowdslam/tracking/tracker.h"
@@ -83,14 +84,33 @@ class System {
 
   // Processes one frame (colour BGR or grey; depth raw CV_16UC1 for RGB-D; right image for stereo,
   // rectified here when the settings have LEFT/RIGHT blocks). Throws InputError for a missing right image.
+  // Observers see the frame before track() returns.
   FrameReport track(const io::FrameImages& images, double timestamp_s);
-  // Lets local mapping finish and stops its thread (idempotent; the destructor calls it).
+  // Lets local mapping (and loop closing) finish their queues and stops their threads (idempotent; the
+  // destructor calls it).
   void shutdown();
+  // Stops the threads as fast as they can: queued keyframes are dropped, running bundle adjustments
+  // aborted (nothing of them applied). For interrupts: what BA already applied stays.
+  void stop_now();
+  // Stops the threads (shutdown() when the run completed, stop_now() otherwise) and tells the observers.
+  void finish(const EndState& end);
 
-  // Every tracked frame, each pose expressed through its reference keyframe so later corrections of the
-  // keyframes propagate (lost frames are left out).
+  // Observers (not owned; see run_observer.h). Add before the first frame.
+  void add_observer(RunObserver* observer) { observers_.push_back(observer); }
+
+  // Every tracked frame of the run, over all map segments, in frame order. Poses of the current map are
+  // expressed through their reference keyframe so later corrections of the keyframes propagate; poses
+  // of maps that were reset are those their map had when it ended (each segment has its own frame).
+  // Lost frames are left out; every frame counted as tracked has a pose here.
   [[nodiscard]] io::Trajectory camera_trajectory() const;
+  // The same, one trajectory per map segment (segments().size() entries, in order).
+  [[nodiscard]] std::vector<io::Trajectory> camera_trajectory_segments() const;
+  // Keyframes of every map segment (earlier maps as they were when reset), in segment order.
   [[nodiscard]] io::Trajectory keyframe_trajectory() const;
+  // The map segments so far (the last one is the current map).
+  [[nodiscard]] std::vector<MapSegment> segments() const;
+  // Frames that have a pose (== camera_trajectory().size()).
+  [[nodiscard]] size_t tracked_frames() const;
   [[nodiscard]] size_t num_keyframes() const;
   [[nodiscard]] size_t num_map_points() const;
   [[nodiscard]] mapping::LocalMapperStats mapper_stats() const;
@@ -106,11 +126,16 @@ class System {
  private:
   struct TrajectoryRecord {
     double timestamp_s = 0;
-    std::shared_ptr<map::KeyFrame> reference;
+    int segment = 0;
+    std::shared_ptr<map::KeyFrame> reference;  // current map only
     geometry::SE3 cam_from_reference;
+    geometry::SE3 world_from_cam;  // at tracking time; after a reset, the map's final pose
     bool tracked = false;
   };
   void reset_map();
+  // The record's pose through its reference keyframe (or the stored one).
+  [[nodiscard]] geometry::SE3 world_from_cam(const TrajectoryRecord& record) const;
+  [[nodiscard]] io::Trajectory live_keyframe_trajectory() const;
   // Reads options_.vocabulary_path into vocabulary_ (nothing for "none"); throws InputError.
   void load_vocabulary();
   void start_people_filter(const io::Settings& settings);
@@ -131,6 +156,9 @@ class System {
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   std::vector<TrajectoryRecord> records_;
+  std::vector<MapSegment> segments_;           // the last one is the current map
+  io::Trajectory past_keyframes_;              // keyframes of maps that were reset
+  std::vector<RunObserver*> observers_;
   std::unique_ptr<people::DetectionWorker> detection_worker_;
   people::KeypointFilterOptions filter_options_;
   people::FeatureBudgetOptions budget_options_;

@@ -1,5 +1,6 @@
 #include "crowdslam/util/text.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
@@ -63,6 +64,23 @@ std::string trim(std::string_view text) {
   while (begin < end && (text[begin] == ' ' || text[begin] == '\t' || text[begin] == '\r' || text[begin] == '\n')) ++begin;
   while (end > begin && (text[end - 1] == ' ' || text[end - 1] == '\t' || text[end - 1] == '\r' || text[end - 1] == '\n')) --end;
   return std::string(text.substr(begin, end - begin));
+}
+
+std::string clip_text(std::string_view text, size_t max_chars) {
+  std::string result;
+  if (text.size() <= max_chars || max_chars < 16) {
+    result.assign(text.substr(0, std::max<size_t>(max_chars, 16)));
+  } else {
+    const size_t tail = (max_chars - 5) / 2;
+    const size_t head = max_chars - 5 - tail;
+    result.assign(text.substr(0, head));
+    result += " ... ";
+    result.append(text.substr(text.size() - tail));
+  }
+  for (char& c : result) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return result;
 }
 
 }  // namespace crowdslam

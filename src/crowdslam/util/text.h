@@ -19,4 +19,8 @@ std::vector<std::string> read_lines(const std::string& path);
 
 std::string trim(std::string_view text);
 
+// `text` cut to at most `max_chars` characters for a message: the start and the end are kept with
+// " ... " between them (paths keep their file name). Control characters become '?'.
+std::string clip_text(std::string_view text, size_t max_chars = 300);
+
 }  // namespace crowdslam

@@ -1,19 +1,35 @@
-#include "crowdslam/system/frame_prefetcher.h"
+#include "crowdslam/run/frame_prefetcher.h"
 
-namespace crowdslam::system {
+#include <spdlog/spdlog.h>
 
-FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames)
-    : source_(source), capacity_(std::max<size_t>(1, capacity)), max_frames_(max_frames) {
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::run {
+
+FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames, bool skip_bad_frames)
+    : source_(source),
+      capacity_(std::max<size_t>(1, capacity)),
+      max_frames_(max_frames),
+      skip_bad_frames_(skip_bad_frames && dynamic_cast<io::Dataset*>(&source) != nullptr) {
   reader_ = std::thread([this] { run(); });
 }
 
 FramePrefetcher::~FramePrefetcher() {
+  cancel();
+  if (reader_.joinable()) reader_.join();
+}
+
+void FramePrefetcher::cancel() {
   {
     std::lock_guard lock(mutex_);
     cancelled_ = true;
   }
   not_full_.notify_all();
-  if (reader_.joinable()) reader_.join();
+}
+
+SkippedFrames FramePrefetcher::skipped() const {
+  std::lock_guard lock(mutex_);
+  return skipped_;
 }
 
 void FramePrefetcher::run() {
@@ -27,6 +43,17 @@ void FramePrefetcher::run() {
     std::optional<io::Frame> frame;
     try {
       frame = source_.next();
+    } catch (const InputError& e) {
+      std::lock_guard lock(mutex_);
+      if (skip_bad_frames_) {
+        if (skipped_.count++ == 0) {
+          skipped_.first_error = e.what();
+          spdlog::warn("skipping a frame that cannot be read (--skip-bad-frames): {}", e.what());
+        }
+        continue;
+      }
+      error_ = std::current_exception();
+      break;
     } catch (...) {
       std::lock_guard lock(mutex_);
       error_ = std::current_exception();
@@ -61,4 +88,4 @@ std::optional<io::Frame> FramePrefetcher::next() {
   return std::nullopt;
 }
 
-}  // namespace crowdslam::system
+}  // namespace crowdslam::run

@@ -1,0 +1,266 @@
+#include "crowdslam/run/run_document.h"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+
+#include "crowdslam/eval/ate.h"
+#include "crowdslam/eval/rpe.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::run {
+
+namespace {
+nlohmann::json optional_json(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+std::string utc_now() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+}  // namespace
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const double position = q * static_cast<double>(values.size() - 1);
+  const auto lower = static_cast<size_t>(std::floor(position));
+  const auto upper = std::min(values.size() - 1, lower + 1);
+  const double t = position - static_cast<double>(lower);
+  return values[lower] * (1 - t) + values[upper] * t;
+}
+
+nlohmann::json frame_json(const system::FrameReport& r) {
+  return {{"index", r.index},
+          {"person_boxes", r.person_boxes},
+          {"people_area", r.people_area},
+          {"keypoints_before_filter", r.keypoints_before_filter},
+          {"detector_ms", r.detector_ms},
+          {"detector_wait_ms", r.detector_wait_ms},
+          {"stereo_matches", r.stereo_matches},
+          {"right_keypoints_removed", r.right_keypoints_removed},
+          {"right_wait_ms", r.right_wait_ms},
+          {"stereo_match_ms", r.stereo_match_ms},
+          {"timestamp", r.timestamp_s},
+          {"extraction_ms", r.extraction_ms},
+          {"tracking_ms", r.tracking_ms},
+          {"total_ms", r.extraction_ms + r.detector_wait_ms + r.tracking_ms},
+          {"keypoints", r.keypoints},
+          {"feature_budget", r.feature_budget},
+          {"tracked_points", r.tracked_points},
+          {"state", tracking::to_string(r.state)},
+          {"method", r.method},
+          {"keyframe", r.new_keyframe}};
+}
+
+nlohmann::json segment_json(const system::MapSegment& s) {
+  return {{"map_id", s.map_id},
+          {"first_frame", s.first_frame},
+          {"last_frame", s.last_frame},
+          {"frames", s.frames},
+          {"tracked", s.tracked},
+          {"first_stamp", s.tracked > 0 ? nlohmann::json(s.first_stamp_s) : nlohmann::json(nullptr)},
+          {"last_stamp", s.tracked > 0 ? nlohmann::json(s.last_stamp_s) : nlohmann::json(nullptr)},
+          {"keyframes", s.keyframes}};
+}
+
+void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary) {
+  std::vector<double> tracking_ms, extraction_ms, total_ms;
+  for (const auto& r : reports) {
+    if (!summary.init_frame && r.method == std::string("init")) summary.init_frame = r.index;
+    tracking_ms.push_back(r.tracking_ms);
+    extraction_ms.push_back(r.extraction_ms);
+    total_ms.push_back(r.extraction_ms + r.detector_wait_ms + r.tracking_ms);
+  }
+  summary.tracking_ms_median = percentile(tracking_ms, 0.5);
+  summary.tracking_ms_p95 = percentile(tracking_ms, 0.95);
+  summary.extraction_ms_median = percentile(extraction_ms, 0.5);
+  summary.total_ms_median = percentile(total_ms, 0.5);
+  summary.total_ms_p95 = percentile(total_ms, 0.95);
+}
+
+void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
+                       const std::vector<io::Trajectory>& segments, const std::vector<system::MapSegment>& info,
+                       bool monocular, RunSummary& summary, nlohmann::json& accuracy) {
+  accuracy = nullptr;
+  if (ground_truth.empty()) return;
+  nlohmann::json per_segment = nlohmann::json::array();
+  std::optional<size_t> longest;
+  for (size_t k = 0; k < segments.size(); ++k) {
+    if (segments[k].empty()) continue;
+    if (!longest || segments[k].size() > segments[*longest].size()) longest = k;
+  }
+  nlohmann::json longest_json = nullptr;
+  for (size_t k = 0; k < segments.size(); ++k) {
+    const io::Trajectory& trajectory = segments[k];
+    if (trajectory.empty()) continue;
+    SegmentAccuracy result;
+    result.map_id = k < info.size() ? info[k].map_id : static_cast<int>(k);
+    result.poses = trajectory.size();
+    nlohmann::json entry = {{"map_id", result.map_id}, {"poses", result.poses}};
+    const std::string name = "CameraTrajectory.txt (map " + std::to_string(result.map_id) + ")";
+    if (trajectory.size() < 3) {
+      result.error = "fewer than 3 poses";
+    } else {
+      try {
+        eval::AteOptions ate_options;
+        ate_options.alignment = monocular ? eval::Alignment::kSim3 : eval::Alignment::kSe3;
+        const auto ate = eval::evaluate_ate(ground_truth, trajectory, ate_options, ground_truth_name, name);
+        result.ate_rmse_m = ate.translation_error_m.rmse;
+        entry.update({{"ate_rmse_m", ate.translation_error_m.rmse},
+                      {"ate_mean_m", ate.translation_error_m.mean},
+                      {"ate_median_m", ate.translation_error_m.median},
+                      {"ate_max_m", ate.translation_error_m.max},
+                      {"ate_pairs", ate.matches.size()},
+                      {"alignment", eval::to_string(ate_options.alignment)}});
+        if (monocular) entry["sim3_scale"] = ate.alignment.scale;
+        // Monocular trajectories have an arbitrary scale: RPE at the aligned scale.
+        eval::RpeOptions rpe_options;
+        if (monocular) rpe_options.scale = ate.alignment.scale;
+        try {
+          const auto rpe = eval::evaluate_rpe(ground_truth, trajectory, rpe_options, ground_truth_name, name);
+          result.rpe_trans_rmse_m = rpe.translation_error_m.rmse;
+          entry["rpe_trans_rmse_m_per_s"] = rpe.translation_error_m.rmse;
+          entry["rpe_rot_rmse_deg_per_s"] = rpe.rotation_error_deg.rmse;
+        } catch (const InputError& e) {
+          entry["rpe_error"] = e.what();
+          if (longest && k == *longest) spdlog::warn("RPE not evaluated (the ATE is): {}", e.what());
+        }
+      } catch (const InputError& e) {
+        result.error = e.what();
+      }
+    }
+    if (!result.error.empty()) {
+      entry["error"] = result.error;
+      if (longest && k == *longest) spdlog::warn("accuracy of map {} not evaluated: {}", result.map_id, result.error);
+    }
+    if (longest && k == *longest) {
+      summary.ate_rmse_m = result.ate_rmse_m;
+      summary.rpe_trans_rmse_m = result.rpe_trans_rmse_m;
+      if (result.ate_rmse_m) summary.evaluated_map_id = result.map_id;
+      longest_json = entry;
+    }
+    summary.segment_accuracy.push_back(result);
+    per_segment.push_back(entry);
+  }
+  if (longest_json.is_null()) return;
+  accuracy = longest_json;
+  accuracy["evaluated"] = segments.size() > 1 ? "longest map segment" : "whole trajectory";
+  accuracy["segments"] = per_segment;
+}
+
+nlohmann::json running_document(const RunOptions& options, const std::string& settings_path, io::SensorKind sensor) {
+  return {{"crowdslam_version", CROWDSLAM_VERSION},
+          {"end_state", "running"},
+          {"pid", static_cast<long>(::getpid())},
+          {"started", utc_now()},
+          {"dataset", options.dataset},
+          {"settings", settings_path},
+          {"sensor", io::to_string(sensor)},
+          {"mode", options.sequential ? "sequential" : "threaded"}};
+}
+
+nlohmann::json final_document(const RunContext& c, const std::vector<system::FrameReport>& reports,
+                              const RunSummary& summary, const nlohmann::json& accuracy) {
+  const auto& slam = c.slam;
+  const auto& s = c.run_settings;
+  nlohmann::json doc = running_document(c.options, c.settings_path, c.sensor);
+  doc.erase("pid");
+  doc["end_state"] = summary.end.to_string();
+  doc["finished"] = utc_now();
+  if (const auto& vocabulary = slam.vocabulary_info()) {
+    doc["vocabulary"] = {{"path", vocabulary->path}, {"words", vocabulary->words}, {"load_ms", vocabulary->load_ms}};
+  } else {
+    doc["vocabulary"] = nullptr;
+  }
+  std::vector<double> detector_ms, detector_wait_ms;
+  for (const auto& r : reports) {
+    detector_ms.push_back(r.detector_ms);
+    detector_wait_ms.push_back(r.detector_wait_ms);
+  }
+  doc["people_filter"] = slam.people_filter_enabled()
+                             ? nlohmann::json{{"detector", slam.detector_name()},
+                                              {"mode", s.people_filter.mode},
+                                              {"margin_px", s.people_filter.margin_px},
+                                              {"filter_before_nms", s.detector.filter_before_nms},
+                                              {"feature_budget", s.feature_budget.enabled},
+                                              {"area", s.feature_budget.area},
+                                              {"detector_ms_median", percentile(detector_ms, 0.5)},
+                                              {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
+                                              {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
+                             : nlohmann::json(nullptr);
+  doc["summary"] = {{"frames", summary.frames},
+                    {"tracked_frames", summary.tracked},
+                    {"tracked_percent", summary.tracked_percent},
+                    {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
+                    {"wall_time_s", c.wall_s},
+                    {"throughput_fps", summary.throughput_fps},
+                    {"tracking_ms_median", summary.tracking_ms_median},
+                    {"tracking_ms_p95", summary.tracking_ms_p95},
+                    {"extraction_ms_median", summary.extraction_ms_median},
+                    {"total_ms_median", summary.total_ms_median},
+                    {"total_ms_p95", summary.total_ms_p95},
+                    {"load_wait_ms_median", percentile(c.load_ms, 0.5)},
+                    {"keyframes", slam.num_keyframes()},
+                    {"map_points", slam.num_map_points()},
+                    {"map_resets", slam.map_resets()},
+                    {"ate_rmse_m", optional_json(summary.ate_rmse_m)},
+                    {"ate_map_id", summary.evaluated_map_id ? nlohmann::json(*summary.evaluated_map_id) : nlohmann::json(nullptr)}};
+  nlohmann::json segments = nlohmann::json::array();
+  for (const auto& segment : summary.segments) segments.push_back(segment_json(segment));
+  doc["segments"] = segments;
+  doc["input"] = c.input;
+  const auto mapper = slam.mapper_stats();
+  const int processed = std::max(1, mapper.keyframes_processed);
+  doc["local_mapping"] = {{"keyframes_processed", mapper.keyframes_processed},
+                          {"points_created", mapper.points_created},
+                          {"points_culled", mapper.points_culled},
+                          {"keyframes_culled", mapper.keyframes_culled},
+                          {"ba_runs", mapper.ba_runs},
+                          {"ba_aborted", mapper.ba_aborted},
+                          {"ba_ms_mean", mapper.ba_runs > 0 ? mapper.ba_time_ms_total / mapper.ba_runs : 0.0},
+                          {"register_ms_mean", mapper.register_ms_total / processed},
+                          {"triangulation_ms_mean", mapper.triangulation_ms_total / processed},
+                          {"fusion_ms_mean", mapper.fusion_ms_total / processed},
+                          {"culling_ms_mean", mapper.culling_ms_total / processed},
+                          {"keyframe_ms_mean", mapper.processing_ms_total / processed}};
+  if (slam.loop_closing_enabled()) {
+    const auto loops = slam.loop_stats();
+    nlohmann::json events = nlohmann::json::array();
+    for (const auto& e : loops.loops) {
+      events.push_back({{"keyframe", e.keyframe_id},
+                        {"loop_keyframe", e.loop_keyframe_id},
+                        {"timestamp", e.timestamp_s},
+                        {"loop_timestamp", e.loop_timestamp_s},
+                        {"matches", e.matches},
+                        {"correction_ms", e.correction_ms}});
+    }
+    doc["loop_closing"] = {{"keyframes_checked", loops.keyframes_checked},
+                           {"candidates_consistent", loops.candidates_consistent},
+                           {"candidates_rejected", loops.candidates_rejected},
+                           {"loops", events},
+                           {"detection_ms_mean", loops.detection_ms_total / std::max(1, loops.keyframes_checked)},
+                           {"global_ba_runs", loops.global_ba.runs},
+                           {"global_ba_applied", loops.global_ba.applied},
+                           {"global_ba_aborted", loops.global_ba.aborted},
+                           {"global_ba_ms_mean", loops.global_ba.time_ms_total / std::max(1, loops.global_ba.runs)}};
+  } else {
+    doc["loop_closing"] = nullptr;
+  }
+  doc["accuracy"] = accuracy;
+  nlohmann::json frames = nlohmann::json::array();
+  for (const auto& r : reports) frames.push_back(frame_json(r));
+  doc["frames"] = std::move(frames);
+  return doc;
+}
+
+}  // namespace crowdslam::run

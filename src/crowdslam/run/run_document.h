@@ -1,0 +1,47 @@
+#pragma once
+// run.json: the document a run writes, assembled from the frames' reports and the system's statistics,
+// and the accuracy of each map segment against the ground truth.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdslam/io/settings.h"
+#include "crowdslam/io/trajectory.h"
+#include "crowdslam/run/run_sequence.h"
+#include "crowdslam/system/system.h"
+
+namespace crowdslam::run {
+
+nlohmann::json frame_json(const system::FrameReport& report);
+nlohmann::json segment_json(const system::MapSegment& segment);
+
+// ATE (Sim3 for monocular, else SE3) and RPE of every segment with at least 3 poses, and the figures of
+// the longest segment (most poses) in the summary. `ground_truth_name` names the file in messages.
+void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
+                       const std::vector<io::Trajectory>& segments, const std::vector<system::MapSegment>& info,
+                       bool monocular, RunSummary& summary, nlohmann::json& accuracy);
+
+// Timing statistics over the frames (median, p95) into `summary`.
+void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary);
+
+double percentile(std::vector<double> values, double q);
+
+// The run.json header written before the first frame ("end_state": "running").
+nlohmann::json running_document(const RunOptions& options, const std::string& settings_path, io::SensorKind sensor);
+
+// The complete document at the end.
+struct RunContext {
+  const RunOptions& options;
+  const std::string& settings_path;
+  io::SensorKind sensor;
+  const io::Settings& run_settings;
+  const system::System& slam;
+  double wall_s;
+  const std::vector<double>& load_ms;
+  nlohmann::json input;  // input warnings and skipped frames
+};
+nlohmann::json final_document(const RunContext& context, const std::vector<system::FrameReport>& reports,
+                              const RunSummary& summary, const nlohmann::json& accuracy);
+
+}  // namespace crowdslam::run

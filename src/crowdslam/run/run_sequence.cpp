@@ -1,0 +1,245 @@
+#include "crowdslam/run/run_sequence.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cassert>
+#include <chrono>
+#include <filesystem>
+
+#include "crowdslam/io/euroc_dataset.h"
+#include "crowdslam/io/settings.h"
+#include "crowdslam/io/trajectory.h"
+#include "crowdslam/journal/output_dir.h"
+#include "crowdslam/journal/run_journal.h"
+#include "crowdslam/run/frame_prefetcher.h"
+#include "crowdslam/run/input_checks.h"
+#include "crowdslam/run/run_document.h"
+#include "crowdslam/system/system.h"
+#include "crowdslam/util/atomic_file.h"
+#include "crowdslam/util/error.h"
+#include "crowdslam/util/interrupt.h"
+#include "crowdslam/util/text.h"
+
+namespace crowdslam::run {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Stereo: raw EuRoC pairs without LEFT/RIGHT blocks are rectified from the dataset's sensor.yaml
+// calibration; otherwise the images must already be rectified (no distortion).
+void prepare_stereo_settings(const io::FrameSource& source, io::Settings& settings) {
+  if (settings.rectification) return;
+  if (const auto* euroc = dynamic_cast<const io::EurocDataset*>(&source)) {
+    const auto right = euroc->right_calibration();
+    const auto right_from_left = euroc->right_from_left();
+    assert(right && right_from_left);  // a stereo EuRoC dataset has cam1
+    const std::string where = source.path() + " (cam0/cam1 sensor.yaml)";
+    system::apply_rectification(settings, system::rectification_from_euroc(euroc->left_calibration(), *right,
+                                                                           *right_from_left, where));
+    spdlog::info("stereo rectification computed from {}: fx {:.3f}, bf {:.4f}", where, settings.camera.fx,
+                 settings.camera.bf);
+    return;
+  }
+  const auto& c = settings.camera;
+  if (c.k1 != 0 || c.k2 != 0 || c.p1 != 0 || c.p2 != 0 || c.k3 != 0) {
+    throw input_error(settings.path, "Camera.k1/k2/p1/p2/k3: stereo images must be rectified, but the camera has "
+                                     "distortion and the settings have no LEFT/RIGHT rectification blocks");
+  }
+}
+
+system::SystemOptions system_options(const RunOptions& options, io::SensorKind sensor) {
+  system::SystemOptions s;
+  s.sensor = sensor;
+  s.sequential = options.sequential;
+  s.people_filter = options.people_filter;
+  s.detections_file = options.detections_file;
+  s.detector_model = options.detector_model;
+  s.record_keypoints = options.save_frames > 0;
+  s.vocabulary_path = options.vocabulary;
+  s.loop_closing = options.loop_closing;
+  return s;
+}
+
+// Everything checked before any output exists: settings, sensor, options.
+struct Prepared {
+  std::unique_ptr<io::FrameSource> source;
+  io::SensorKind sensor = io::SensorKind::kRgbd;
+  std::string settings_path;
+  io::Settings settings;      // as read
+  io::Settings run_settings;  // with the options applied
+};
+
+Prepared prepare(const RunOptions& options) {
+  Prepared p;
+  p.source = io::open_source(options.dataset);
+  if (const auto frames = p.source->summary().frames; frames && *frames == 0) {
+    throw InputError(clip_text(options.dataset) + ": no frames");
+  }
+  p.settings_path = options.settings_path.empty() ? p.source->default_settings_path() : options.settings_path;
+  if (p.settings_path.empty()) {
+    throw InputError(clip_text(options.dataset) + ": no settings given (--settings) and the dataset has no settings.yaml");
+  }
+  check_requested_sensor(*p.source, options.sensor);
+  p.settings = io::load_settings(p.settings_path, options.sensor.value_or(p.source->sensor()));
+  p.sensor = choose_sensor(*p.source, p.settings, options.sensor);
+  p.run_settings = p.settings;
+  if (!options.filter_mode.empty()) {
+    if (options.filter_mode != "paper" && options.filter_mode != "depth") {
+      throw InputError("--filter-mode: expected 'paper' or 'depth', got '" + clip_text(options.filter_mode, 60) + "'");
+    }
+    p.run_settings.people_filter.mode = options.filter_mode;
+  }
+  if (p.sensor == io::SensorKind::kStereo) prepare_stereo_settings(*p.source, p.run_settings);
+  check_first_frame(*p.source, p.settings);
+  return p;
+}
+
+void write_final_outputs(const std::filesystem::path& out, const system::System& slam, io::TrajectoryFormat format,
+                         const nlohmann::json& doc) {
+  io::write_trajectory((out / "CameraTrajectory.txt").string(), slam.camera_trajectory(), format);
+  io::write_trajectory((out / "KeyFrameTrajectory.txt").string(), slam.keyframe_trajectory(), format);
+  write_file_atomic(out / "run.json", doc.dump(1) + "\n");
+}
+
+}  // namespace
+
+RunSummary run_sequence(const RunOptions& options) {
+  journal::check_output_dir(options.out_dir, options.overwrite);  // before anything is read
+  Prepared p = prepare(options);
+  system::System slam(p.run_settings, system_options(options, p.sensor));
+
+  // From here on the run has outputs: the directory, run.json saying "running", the journal.
+  const std::filesystem::path out(options.out_dir);
+  std::error_code ec;
+  const bool created = !std::filesystem::exists(out, ec);
+  const auto removed = journal::prepare_output_dir(out, options.overwrite);
+  if (!removed.empty()) spdlog::info("{}: replaced the earlier run ({} entries)", clip_text(options.out_dir), removed.size());
+  const auto format = io::parse_trajectory_format(p.settings.output.trajectory_format);
+  journal::RunJournalOptions journal_options;
+  journal_options.out_dir = out;
+  journal_options.format = format;
+  journal_options.save_every = options.save_frames;
+  journal_options.flush_every_poses = options.journal_flush_frames;
+  std::unique_ptr<journal::RunJournal> journal_ptr;
+  try {
+    write_file_atomic(out / "run.json", running_document(options, p.settings_path, p.sensor).dump(1) + "\n");
+    journal_ptr = std::make_unique<journal::RunJournal>(journal_options);
+  } catch (...) {  // nothing was run yet: leave nothing behind
+    if (created) {
+      remove_quietly(out);
+    } else {
+      for (const char* name : {"run.json", "CameraTrajectory.txt", "frames"}) remove_quietly(out / name);
+    }
+    throw;
+  }
+  journal::RunJournal& journal = *journal_ptr;
+  slam.add_observer(&journal);
+
+  InputMonitor monitor(p.run_settings, p.sensor);
+  std::vector<system::FrameReport> reports;
+  std::vector<double> load_ms;  // time tracking waited for the next decoded frame
+  system::EndState end;
+  std::exception_ptr error;
+  const auto run_start = Clock::now();
+  const size_t expected = p.source->summary().frames.value_or(0);
+  FramePrefetcher prefetcher(*p.source, 3, options.max_frames, options.skip_bad_frames);
+  try {
+    while (true) {
+      if (const int signal = interrupt_signal()) {
+        end.kind = system::EndState::Kind::kInterrupted;
+        end.signal = signal;
+        break;
+      }
+      const auto load_start = Clock::now();
+      auto frame = prefetcher.next();
+      if (!frame) break;
+      load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - load_start).count());
+      monitor.check_frame(*frame);
+      reports.push_back(slam.track(frame->images, frame->info.timestamp_s));
+      auto& report = reports.back();
+      monitor.after_tracking(*frame, report.keypoints_before_filter);
+      // Drawn by the journal (it copied what it needs): run.json does not keep them.
+      report.kept_keypoints = {};
+      report.removed_keypoints = {};
+      report.boxes = {};
+      journal.check();
+      if (options.progress && reports.size() % 100 == 0) {
+        spdlog::info("frame {}/{}: {} tracked, {} keyframes, {} map points", reports.size(), expected,
+                     slam.tracked_frames(), slam.num_keyframes(), slam.num_map_points());
+      }
+    }
+  } catch (const std::exception& e) {
+    end.kind = system::EndState::Kind::kFailed;
+    end.reason = e.what();
+    error = std::current_exception();
+  }
+  const double wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
+  prefetcher.cancel();
+  slam.finish(end);  // stops the threads; the journal drains and closes
+  if (end.kind != system::EndState::Kind::kFailed) {
+    try {
+      journal.check();
+    } catch (const std::exception& e) {
+      end.kind = system::EndState::Kind::kFailed;
+      end.reason = e.what();
+      error = std::current_exception();
+    }
+  }
+  if (end.kind == system::EndState::Kind::kInterrupted) {
+    spdlog::warn("run interrupted by {} after {} frames; writing the outputs", signal_name(end.signal), reports.size());
+  }
+
+  RunSummary summary;
+  summary.out_dir = options.out_dir;
+  summary.frames = reports.size();
+  summary.tracked = slam.tracked_frames();
+  summary.tracked_percent =
+      summary.frames > 0 ? 100.0 * static_cast<double>(summary.tracked) / static_cast<double>(summary.frames) : 0.0;
+  summary.throughput_fps = wall_s > 0 ? static_cast<double>(summary.frames) / wall_s : 0.0;
+  summary.segments = slam.segments();
+  summarise_frames(reports, summary);
+  monitor.warn_totals();
+  if (p.sensor == io::SensorKind::kMonocular && !summary.init_frame && summary.frames > 0) {
+    spdlog::warn("{}: monocular map never initialised in {} frames (needs a textured scene and a camera that "
+                 "translates, not only rotates)",
+                 clip_text(options.dataset), summary.frames);
+  }
+  const bool untracked = end.completed() && summary.tracked == 0 && !options.allow_untracked;
+  if (untracked) {
+    end.kind = system::EndState::Kind::kFailed;
+    end.reason = "no frame was tracked (0 of " + std::to_string(summary.frames) + ")";
+  }
+  summary.end = end;
+
+  nlohmann::json accuracy = nullptr;
+  const auto ground_truth_name = p.source->summary().ground_truth_path;
+  evaluate_accuracy(p.source->ground_truth(), ground_truth_name.empty() ? "ground truth" : clip_text(ground_truth_name),
+                    slam.camera_trajectory_segments(), summary.segments, p.sensor == io::SensorKind::kMonocular,
+                    summary, accuracy);
+  const SkippedFrames skipped = prefetcher.skipped();
+  nlohmann::json input = monitor.to_json();
+  input["skipped_frames"] = skipped.count;
+  input["first_skipped_error"] = skipped.first_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(skipped.first_error);
+  if (skipped.count > 1) spdlog::warn("{} unreadable frames skipped (first: {})", skipped.count, skipped.first_error);
+  const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam, wall_s, load_ms, input};
+  summary.json = final_document(context, reports, summary, accuracy);
+  write_final_outputs(out, slam, format, summary.json);
+
+  if (error) {
+    const std::string where = " (the " + std::to_string(summary.tracked) + " frames tracked before it are in " +
+                              clip_text(options.out_dir) + ", run.json says \"failed\")";
+    try {
+      std::rethrow_exception(error);
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + where);
+    }
+  }
+  if (untracked) {
+    throw InputError(clip_text(options.dataset) + ": " + end.reason +
+                     "; outputs are in " + clip_text(options.out_dir) + " (--allow-untracked accepts such a run)");
+  }
+  return summary;
+}
+
+}  // namespace crowdslam::run
