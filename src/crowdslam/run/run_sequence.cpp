@@ -160,9 +160,10 @@ RunSummary run_sequence(const RunOptions& options) {
       auto& report = reports.back();
       monitor.after_tracking(*frame, report.keypoints_before_filter);
       // Drawn by the journal (it copied what it needs): run.json does not keep them.
-      report.kept_keypoints = {};
-      report.removed_keypoints = {};
-      report.boxes = {};
+      // (swap, not `= {}`: that keeps the capacity, 40 MB over bonn_crowd's 927 frames).
+      std::vector<cv::KeyPoint>().swap(report.kept_keypoints);
+      std::vector<cv::KeyPoint>().swap(report.removed_keypoints);
+      std::vector<people::PersonBox>().swap(report.boxes);
       journal.check();
       if (options.progress && reports.size() % 100 == 0) {
         spdlog::info("frame {}/{}: {} tracked, {} keyframes, {} map points", reports.size(), expected,
