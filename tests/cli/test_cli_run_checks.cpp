@@ -91,3 +91,19 @@ TEST(CliRunChecks, BadFilterModeNamesTheOptionNotTheSettingsFile) {
   expect_refused(r, out, {"--filter-mode", "bogus"});
   EXPECT_EQ(r.err.find("settings.yaml"), std::string::npos) << r.err;
 }
+
+TEST(CliRunChecks, ShortRunSaysWhichAccuracyFigureIsMissing) {
+  TempDir dir;
+  const auto seq = synth_small(dir, 20);  // 0.67 s: an ATE, but no RPE pair 1 s apart
+  const auto out = dir / "out";
+  const auto r = run_cli({"run", "--dataset", seq.string(), "--out", out.string(), "--no-people-filter", "--sequential"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("ATE RMSE"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("RPE not evaluated (the ATE is)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("accuracy not evaluated"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("ground truth ground truth"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("groundtruth.txt"), std::string::npos) << r.err;  // the file is named instead
+  const auto accuracy = read_json(out / "run.json")["accuracy"];
+  EXPECT_TRUE(accuracy.contains("ate_rmse_m"));
+  EXPECT_TRUE(accuracy.contains("rpe_error"));
+}

@@ -92,6 +92,19 @@ TEST(CliRunSignals, SecondSignalExitsAtOnceWithoutTemporaries) {
   for (const auto& line : trajectory_lines(out / "CameraTrajectory.txt")) EXPECT_EQ(count_fields(line), 8u) << line;
 }
 
+TEST(CliRunSignals, KilledRunLeavesAValidPartialJournalMarkedRunning) {
+  TempDir dir;
+  const auto seq = synth_small(dir, 300);
+  const auto out = dir / "out";
+  const auto r = interrupt_run({"run", "--dataset", seq.string(), "--out", out.string(), "--no-people-filter"}, out, 30,
+                               SIGKILL);
+  EXPECT_EQ(r.result.exit_code, 128 + SIGKILL);
+  EXPECT_EQ(read_json(out / "run.json")["end_state"], "running");  // nothing could say otherwise
+  const auto lines = trajectory_lines(out / "CameraTrajectory.txt");
+  EXPECT_GE(lines.size(), r.journal_poses_at_signal);
+  for (const auto& line : lines) EXPECT_EQ(count_fields(line), 8u) << line;
+}
+
 TEST(CliRunSignals, BonnInterruptedAtFrame400KeepsAbout400Poses) {
   CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
   TempDir dir;

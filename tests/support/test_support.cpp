@@ -61,33 +61,6 @@ std::string read_text(const std::filesystem::path& path) {
   return ss.str();
 }
 
-CliResult run_cli(const std::vector<std::string>& args) {
-  TempDir tmp;
-  const auto out_path = tmp / "stdout";
-  const auto err_path = tmp / "stderr";
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    if (!std::freopen(out_path.c_str(), "w", stdout) || !std::freopen(err_path.c_str(), "w", stderr)) _exit(127);
-    std::vector<char*> argv;
-    std::string program = CROWDSLAM_CLI_PATH;
-    argv.push_back(program.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(program.c_str(), argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  CliResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.out = read_text(out_path);
-  result.err = read_text(err_path);
-  return result;
-}
-
 namespace {
 [[noreturn]] void exec_cli(const std::vector<std::string>& args) {
   std::vector<char*> argv;
@@ -159,6 +132,11 @@ CliResult CliProcess::wait(double timeout_s) {
   result.out = read_text(tmp_ / "stdout");
   result.err = read_text(tmp_ / "stderr");
   return result;
+}
+
+CliResult run_cli(const std::vector<std::string>& args) {
+  CliProcess child(args);
+  return child.wait(3600);
 }
 
 }  // namespace crowdslam::test
