@@ -14,6 +14,7 @@ namespace {
 struct RunArgs {
   run::RunOptions options;
   std::string sensor;
+  std::string pace = "none";
   size_t frames = 0;
 };
 
@@ -75,6 +76,10 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "'none' relocalises by brute-force matching");
   cmd->add_flag("!--no-loop-closing", args->options.loop_closing,
                 "Run without the loop closing thread (no place recognition, no pose-graph or global BA)");
+  cmd->add_option("--pace", args->pace,
+                  "none: every frame as fast as possible (default); sensor: replay at the recorded rate, dropping "
+                  "(and counting) frames that arrive while tracking is busy, as a live camera does")
+      ->check(CLI::IsMember({"none", "sensor"}));
   cmd->add_flag("--skip-bad-frames", args->options.skip_bad_frames,
                 "Skip (count and warn about) frames that cannot be read instead of failing the run");
   cmd->add_flag("--allow-untracked", args->options.allow_untracked,
@@ -82,6 +87,7 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
   cmd->callback([args, &global] {
     if (!args->sensor.empty()) args->options.sensor = io::parse_sensor_kind(args->sensor, "--sensor");
     args->options.max_frames = args->frames;
+    args->options.pace_sensor = args->pace == "sensor";
     args->options.progress = !global.quiet;
     InterruptScope interrupts;  // Ctrl-C / SIGTERM / SIGHUP stop the run and write its outputs
     const auto summary = run::run_sequence(args->options);

@@ -17,6 +17,7 @@ void LocalMapperOptions::check() const {
   if (max_local_ba_keyframes < 1) throw InputError("local mapper: max_local_ba_keyframes must be >= 1");
   if (triangulation_neighbours < 1) throw InputError("local mapper: triangulation_neighbours must be >= 1");
   if (!(redundancy_ratio > 0 && redundancy_ratio <= 1)) throw InputError("local mapper: redundancy_ratio in (0, 1]");
+  if (!(delay_ms >= 0)) throw InputError("local mapper: delay_ms must be >= 0");
   ba.check();
 }
 
@@ -39,6 +40,7 @@ void LocalMapper::start() {
     std::lock_guard lock(queue_mutex_);
     worker_active_ = false;
     paused_cv_.notify_all();
+    idle_cv_.notify_all();
   });
 }
 
@@ -72,10 +74,12 @@ void LocalMapper::run() {
     {
       std::unique_lock lock(queue_mutex_);
       accepting_ = true;
+      if (queue_.empty()) idle_cv_.notify_all();
       queue_cv_.wait(lock, [this] { return stop_requested_ || !queue_.empty() || pause_requested_; });
       if (pause_requested_) {  // loop correction or global BA: wait here until resumed
         paused_ = true;
         paused_cv_.notify_all();
+        idle_cv_.notify_all();
         queue_cv_.wait(lock, [this] { return !pause_requested_; });
         paused_ = false;
         continue;
@@ -141,6 +145,15 @@ size_t LocalMapper::queued_keyframes() const {
   return queue_.size();
 }
 
+bool LocalMapper::wait_until_accepting(double timeout_ms) {
+  std::unique_lock lock(queue_mutex_);
+  // Sequential mode (no worker): keyframes are processed inline, so the mapper is idle whenever asked.
+  idle_cv_.wait_for(lock, std::chrono::duration<double, std::milli>(timeout_ms), [this] {
+    return (accepting_ && queue_.empty()) || !worker_active_ || stop_requested_ || pause_requested_;
+  });
+  return accepting_ && queue_.empty();
+}
+
 bool LocalMapper::has_new_keyframes() const { return queued_keyframes() > 0; }
 
 void LocalMapper::interrupt_bundle_adjustment() { abort_ba_ = true; }
@@ -164,6 +177,7 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
   };
   const auto start = Clock::now();
+  if (options_.delay_ms > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(options_.delay_ms));
   register_keyframe(keyframe);
   cull_recent_points(keyframe);
   const double register_ms = ms_since(start);

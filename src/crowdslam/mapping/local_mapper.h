@@ -38,6 +38,7 @@ struct LocalMapperOptions {
   // after a loop merges two passes over a place that becomes hundreds (see docs/ARCHITECTURE.md).
   int max_local_ba_keyframes = 25;
   optim::BundleAdjustmentOptions ba;
+  double delay_ms = 0;  // experiments and tests: sleep this long per keyframe (an artificially slow mapper)
   void check() const;
 };
 
@@ -79,6 +80,7 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   void insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe) override;
   [[nodiscard]] bool accepts_keyframes() const override;
   [[nodiscard]] size_t queued_keyframes() const override;
+  bool wait_until_accepting(double timeout_ms) override;
   void interrupt_bundle_adjustment() override;
   [[nodiscard]] bool is_paused() const override { return pause_requested_; }
 
@@ -125,6 +127,7 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   bool paused_ = false;         // the worker is waiting in a pause (queue_mutex_)
   bool worker_active_ = false;  // the worker thread is running (queue_mutex_)
   std::condition_variable paused_cv_;
+  std::condition_variable idle_cv_;  // the worker finished its queue and waits for keyframes
   std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done_;
   std::atomic<bool> accepting_{true};
   std::atomic<bool> abort_ba_{false};

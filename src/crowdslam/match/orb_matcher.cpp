@@ -169,55 +169,117 @@ geometry::Mat3 fundamental_between(const map::KeyFrame& kf1, const map::KeyFrame
   return k2_inv.transpose() * essential * k1_inv;
 }
 
+namespace {
+// The candidate test of the triangulation search: kf1 keypoint i against kf2 keypoint j.
+class TriangulationCandidates {
+ public:
+  TriangulationCandidates(const map::KeyFrame& kf1, const map::KeyFrame& kf2, const geometry::Mat3& fundamental_21)
+      : f1_(*kf1.features), f2_(*kf2.features), levels_(*kf2.levels), fundamental_21_(fundamental_21) {
+    // Epipole: kf1's camera centre seen from kf2.
+    const geometry::Vec3 c1_in_2 = kf2.cam_from_world() * kf1.camera_center();
+    epipole_ = kf2.camera->project(c1_in_2);
+    epipole_valid_ = c1_in_2.z() > 0;
+  }
+
+  // Prepares keypoint i of kf1; false when it has no usable epipolar line.
+  bool start(size_t i) {
+    const cv::KeyPoint& kp1 = f1_.keys_un[i];
+    line_ = fundamental_21_ * geometry::Vec3(kp1.pt.x, kp1.pt.y, 1.0);
+    line_norm2_ = line_.x() * line_.x() + line_.y() * line_.y();
+    descriptor_ = f1_.descriptor(i);
+    best_distance_ = kThLow;
+    best_index_ = -1;
+    return line_norm2_ > 0;
+  }
+
+  void consider(size_t j) {
+    const int distance = hamming_distance(descriptor_, f2_.descriptor(j));
+    if (distance > best_distance_) return;
+    const cv::KeyPoint& kp2 = f2_.keys_un[j];
+    if (!f2_.has_right(j) && epipole_valid_) {
+      const double ex = epipole_.x() - kp2.pt.x;
+      const double ey = epipole_.y() - kp2.pt.y;
+      if (ex * ex + ey * ey < 100.0 * levels_.scale[kp2.octave]) return;
+    }
+    const double num = line_.x() * kp2.pt.x + line_.y() * kp2.pt.y + line_.z();
+    if (num * num / line_norm2_ >= 3.84 * levels_.sigma2[kp2.octave]) return;
+    best_distance_ = distance;
+    best_index_ = static_cast<int>(j);
+  }
+
+  [[nodiscard]] int best() const { return best_index_; }
+
+ private:
+  const map::FrameFeatures& f1_;
+  const map::FrameFeatures& f2_;
+  const map::ScaleLevels& levels_;
+  const geometry::Mat3& fundamental_21_;
+  geometry::Vec2 epipole_;
+  bool epipole_valid_ = false;
+  geometry::Vec3 line_;
+  double line_norm2_ = 0;
+  const uint8_t* descriptor_ = nullptr;
+  int best_distance_ = kThLow;
+  int best_index_ = -1;
+};
+}  // namespace
+
 std::vector<std::pair<size_t, size_t>> search_for_triangulation(const map::KeyFrame& kf1, const map::KeyFrame& kf2,
                                                                 const geometry::Mat3& fundamental_21,
                                                                 bool only_stereo, bool check_orientation) {
   const map::FrameFeatures& f1 = *kf1.features;
   const map::FrameFeatures& f2 = *kf2.features;
-  const map::ScaleLevels& levels = *kf2.levels;
-  // Epipole: kf1's camera centre seen from kf2.
-  const geometry::Vec3 c1_in_2 = kf2.cam_from_world() * kf1.camera_center();
-  const geometry::Vec2 epipole = kf2.camera->project(c1_in_2);
-  const bool epipole_valid = c1_in_2.z() > 0;
-
   const auto points1 = kf1.map_points();
   const auto points2 = kf2.map_points();
-  std::vector<size_t> free2;
-  for (size_t j = 0; j < points2.size(); ++j) {
-    if (!points2[j] && (!only_stereo || f2.has_right(j))) free2.push_back(j);
-  }
+  std::vector<bool> free1(points1.size()), free2(points2.size());
+  for (size_t i = 0; i < points1.size(); ++i) free1[i] = !points1[i] && (!only_stereo || f1.has_right(i));
+  for (size_t j = 0; j < points2.size(); ++j) free2[j] = !points2[j] && (!only_stereo || f2.has_right(j));
   std::vector<bool> matched2(points2.size(), false);
   std::vector<std::pair<size_t, size_t>> matches;
   RotationHistogram histogram;
-  for (size_t i = 0; i < points1.size(); ++i) {
-    if (points1[i]) continue;
-    if (only_stereo && !f1.has_right(i)) continue;
-    const cv::KeyPoint& kp1 = f1.keys_un[i];
-    const geometry::Vec3 line = fundamental_21 * geometry::Vec3(kp1.pt.x, kp1.pt.y, 1.0);
-    const double line_norm2 = line.x() * line.x() + line.y() * line.y();
-    if (line_norm2 <= 0) continue;
-    const uint8_t* d1 = f1.descriptor(i);
-    int best_distance = kThLow;
-    int best_index = -1;
-    for (size_t j : free2) {
-      if (matched2[j]) continue;
-      const int distance = hamming_distance(d1, f2.descriptor(j));
-      if (distance > best_distance) continue;
-      const cv::KeyPoint& kp2 = f2.keys_un[j];
-      if (!f2.has_right(j) && epipole_valid) {
-        const double ex = epipole.x() - kp2.pt.x;
-        const double ey = epipole.y() - kp2.pt.y;
-        if (ex * ex + ey * ey < 100.0 * levels.scale[kp2.octave]) continue;
+  TriangulationCandidates candidates(kf1, kf2, fundamental_21);
+  const auto accept = [&](size_t i) {
+    const int best = candidates.best();
+    if (best < 0) return;
+    matched2[static_cast<size_t>(best)] = true;
+    if (check_orientation) histogram.add(f1.keys_un[i].angle - f2.keys_un[static_cast<size_t>(best)].angle, matches.size());
+    matches.emplace_back(i, static_cast<size_t>(best));
+  };
+  if (!f1.bow_features.empty() && !f2.bow_features.empty()) {
+    // ORB-SLAM2's idea: only keypoints under the same vocabulary node (direct index) are compared.
+    auto it1 = f1.bow_features.begin();
+    auto it2 = f2.bow_features.begin();
+    while (it1 != f1.bow_features.end() && it2 != f2.bow_features.end()) {
+      if (it1->first < it2->first) {
+        it1 = f1.bow_features.lower_bound(it2->first);
+        continue;
       }
-      const double num = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
-      if (num * num / line_norm2 >= 3.84 * levels.sigma2[kp2.octave]) continue;
-      best_distance = distance;
-      best_index = static_cast<int>(j);
+      if (it2->first < it1->first) {
+        it2 = f2.bow_features.lower_bound(it1->first);
+        continue;
+      }
+      for (const unsigned i : it1->second) {
+        if (!free1[i] || !candidates.start(i)) continue;
+        for (const unsigned j : it2->second) {
+          if (free2[j] && !matched2[j]) candidates.consider(j);
+        }
+        accept(i);
+      }
+      ++it1;
+      ++it2;
     }
-    if (best_index < 0) continue;
-    matched2[static_cast<size_t>(best_index)] = true;
-    if (check_orientation) histogram.add(kp1.angle - f2.keys_un[static_cast<size_t>(best_index)].angle, matches.size());
-    matches.emplace_back(i, static_cast<size_t>(best_index));
+  } else {  // no vocabulary: every free pair
+    std::vector<size_t> free2_list;
+    for (size_t j = 0; j < points2.size(); ++j) {
+      if (free2[j]) free2_list.push_back(j);
+    }
+    for (size_t i = 0; i < points1.size(); ++i) {
+      if (!free1[i] || !candidates.start(i)) continue;
+      for (size_t j : free2_list) {
+        if (!matched2[j]) candidates.consider(j);
+      }
+      accept(i);
+    }
   }
   if (check_orientation) {
     auto rejected = histogram.rejected();

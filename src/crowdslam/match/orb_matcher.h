@@ -54,6 +54,8 @@ int search_keyframe_window(map::Frame& frame, const map::KeyFrame& keyframe, dou
 // constraint (distance to the epipolar line below 3.84 sigma^2 at kf2's level) and match by descriptor
 // (< kThLow, ratio 0.6... as ORB-SLAM: best only), with the rotation check. Used to triangulate new points.
 // `fundamental_21` maps kf1 pixels to lines in kf2 (l2 = F21 * x1).
+// When both keyframes carry a direct index (bag of words), only keypoints under the same vocabulary node
+// are compared (ORB-SLAM2's SearchForTriangulation); without, every free pair.
 std::vector<std::pair<size_t, size_t>> search_for_triangulation(const map::KeyFrame& kf1, const map::KeyFrame& kf2,
                                                                 const geometry::Mat3& fundamental_21,
                                                                 bool only_stereo = false,

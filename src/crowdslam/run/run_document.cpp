@@ -59,7 +59,8 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"tracked_points", r.tracked_points},
           {"state", tracking::to_string(r.state)},
           {"method", r.method},
-          {"keyframe", r.new_keyframe}};
+          {"keyframe", r.new_keyframe},
+          {"waited_for_mapping_ms", r.waited_for_mapping_ms}};
 }
 
 nlohmann::json segment_json(const system::MapSegment& s) {
@@ -183,9 +184,13 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     doc["vocabulary"] = nullptr;
   }
   std::vector<double> detector_ms, detector_wait_ms;
+  double waited_for_mapping_ms = 0;
+  int frames_waited = 0;
   for (const auto& r : reports) {
     detector_ms.push_back(r.detector_ms);
     detector_wait_ms.push_back(r.detector_wait_ms);
+    waited_for_mapping_ms += r.waited_for_mapping_ms;
+    frames_waited += r.waited_for_mapping_ms > 0 ? 1 : 0;
   }
   doc["people_filter"] = slam.people_filter_enabled()
                              ? nlohmann::json{{"detector", slam.detector_name()},
@@ -213,6 +218,8 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                     {"keyframes", slam.num_keyframes()},
                     {"map_points", slam.num_map_points()},
                     {"map_resets", slam.map_resets()},
+                    {"waited_for_mapping_ms", waited_for_mapping_ms},
+                    {"frames_waited_for_mapping", frames_waited},
                     {"ate_rmse_m", optional_json(summary.ate_rmse_m)},
                     {"ate_map_id", summary.evaluated_map_id ? nlohmann::json(*summary.evaluated_map_id) : nlohmann::json(nullptr)}};
   nlohmann::json segments = nlohmann::json::array();

@@ -13,6 +13,7 @@
 #include "crowdslam/journal/run_journal.h"
 #include "crowdslam/run/frame_prefetcher.h"
 #include "crowdslam/run/input_checks.h"
+#include "crowdslam/run/sensor_pacer.h"
 #include "crowdslam/run/run_document.h"
 #include "crowdslam/system/system.h"
 #include "crowdslam/util/atomic_file.h"
@@ -144,6 +145,9 @@ RunSummary run_sequence(const RunOptions& options) {
   const auto run_start = Clock::now();
   const size_t expected = p.source->summary().frames.value_or(0);
   FramePrefetcher prefetcher(*p.source, 3, options.max_frames, options.skip_bad_frames);
+  std::optional<SensorPacer> pacer;
+  size_t dropped_after_tracking = 0;
+  if (options.pace_sensor) pacer.emplace();
   try {
     while (true) {
       if (const int signal = interrupt_signal()) {
@@ -155,6 +159,10 @@ RunSummary run_sequence(const RunOptions& options) {
       auto frame = prefetcher.next();
       if (!frame) break;
       load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - load_start).count());
+      if (pacer && !pacer->admit(frame->info.timestamp_s)) {  // arrived while tracking was busy: dropped
+        if (slam.tracked_frames() > 0) ++dropped_after_tracking;
+        continue;
+      }
       monitor.check_frame(*frame);
       reports.push_back(slam.track(frame->images, frame->info.timestamp_s));
       auto& report = reports.back();
@@ -220,6 +228,13 @@ RunSummary run_sequence(const RunOptions& options) {
                     summary, accuracy);
   const SkippedFrames skipped = prefetcher.skipped();
   nlohmann::json input = monitor.to_json();
+  input["pace"] = pacer ? "sensor" : "none";
+  input["dropped_frames"] = pacer ? pacer->dropped() : 0;
+  input["dropped_after_first_tracked"] = dropped_after_tracking;
+  if (pacer && pacer->dropped() > 0) {
+    spdlog::info("--pace sensor: {} frames dropped because tracking was busy when they arrived ({} after the first "
+                 "tracked frame)", pacer->dropped(), dropped_after_tracking);
+  }
   input["skipped_frames"] = skipped.count;
   input["first_skipped_error"] = skipped.first_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(skipped.first_error);
   if (skipped.count > 1) spdlog::warn("{} unreadable frames skipped (first: {})", skipped.count, skipped.first_error);

@@ -50,6 +50,10 @@ struct RunOptions {
   bool skip_bad_frames = false;     // --skip-bad-frames: an unreadable frame is counted and skipped
   bool allow_untracked = false;     // --allow-untracked: a run that tracks no frame is not an error
   size_t journal_flush_frames = 10; // the trajectory journal is flushed every N tracked frames
+  // --pace sensor: frames are replayed at their timestamps (as a live camera delivers them); a frame
+  // whose successor has already arrived when tracking gets to it is dropped and counted, as a camera
+  // driver drops frames nobody took. Default: every frame, as fast as the system goes.
+  bool pace_sensor = false;
 };
 
 // Accuracy of one trajectory (a map segment) against the ground truth.

@@ -79,10 +79,12 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   mapping::LocalMapperOptions mapper_options;
   mapper_options.monocular = options.sensor == io::SensorKind::kMonocular;
   mapper_options.close_depth_m = close_depth_m;
+  mapper_options.delay_ms = options.mapper_delay_ms;
   mapper_ = std::make_unique<mapping::LocalMapper>(mapper_options, map_);
 
   tracking::TrackerOptions tracker_options;
   tracker_options.close_depth_m = close_depth_m;
+  tracker_options.max_wait_for_mapping_ms = options.sequential ? 0.0 : options.max_wait_for_mapping_ms;
   tracker_options.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   if (options.sensor == io::SensorKind::kMonocular) {
     tracker_options.monocular = true;
@@ -370,6 +372,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.state = result.state;
   report.method = result.method;
   report.new_keyframe = result.new_keyframe;
+  report.waited_for_mapping_ms = result.waited_for_mapping_ms;
   report.tracked_points = result.tracked_points;
 
   TrajectoryRecord record;
@@ -392,6 +395,23 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     segment.last_stamp_s = timestamp_s;
   }
   records_.push_back(std::move(record));
+  // Monocular initialisation makes its reference frame (an earlier frame, reported not initialised then)
+  // the first keyframe: that frame's pose is the keyframe's, so it is tracked too.
+  const auto keyframes = options_.sensor == io::SensorKind::kMonocular && result.method == std::string("init")
+                             ? map_->keyframes()  // sorted by id: the first is the reference frame's
+                             : std::vector<std::shared_ptr<map::KeyFrame>>{};
+  if (!keyframes.empty() && keyframes.front()->frame_id < records_.size()) {
+    const auto& first = keyframes.front();
+    TrajectoryRecord& initial = records_[first->frame_id];
+    if (!initial.tracked && initial.segment == map_resets_) {
+      initial.tracked = true;
+      initial.reference = first;
+      initial.cam_from_reference = geometry::SE3();
+      initial.world_from_cam = first->world_from_cam();
+      ++segments_.back().tracked;
+      segments_.back().first_stamp_s = initial.timestamp_s;
+    }
+  }
   for (auto* observer : observers_) observer->on_frame(report, world_from_cam, images);
   if (result.new_keyframe && result.reference_keyframe) {  // a new keyframe becomes the reference
     for (auto* observer : observers_) observer->on_keyframe(result.reference_keyframe->id);

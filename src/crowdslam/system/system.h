@@ -37,6 +37,11 @@ struct SystemOptions {
   std::string vocabulary_path;
   // Loop closing thread (needs a vocabulary). Off: tracking, mapping and relocalisation only.
   bool loop_closing = true;
+  // Backpressure (tracking/tracker.h TrackerOptions::max_wait_for_mapping_ms): how long tracking may
+  // wait for local mapping to take an urgently needed keyframe. 0 = never (ORB-SLAM2).
+  double max_wait_for_mapping_ms = 1000.0;
+  // Experiments and tests only: local mapping sleeps this long per keyframe (a slow mapper on demand).
+  double mapper_delay_ms = 0;
 };
 
 // The vocabulary a System loaded, for run.json.
@@ -58,6 +63,7 @@ struct FrameReport {
   tracking::TrackingState state = tracking::TrackingState::kNotInitialized;
   std::string method;
   bool new_keyframe = false;
+  double waited_for_mapping_ms = 0;  // part of tracking_ms: waiting for local mapping to take a keyframe
   // People filter.
   int person_boxes = 0;
   double people_area = 0;      // fraction of the image covered (sum or union, FeatureBudget.area)

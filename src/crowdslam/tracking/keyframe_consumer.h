@@ -17,6 +17,10 @@ class KeyframeConsumer {
   // True when the mapper is idle and would take a keyframe right away.
   [[nodiscard]] virtual bool accepts_keyframes() const = 0;
   [[nodiscard]] virtual size_t queued_keyframes() const = 0;
+  // Blocks until the mapper accepts keyframes (idle, empty queue), is paused or stopped, or `timeout_ms`
+  // passes. Returns accepts_keyframes(). Call without holding the map-update lock (the mapper takes it to
+  // write bundle adjustment results back).
+  virtual bool wait_until_accepting(double timeout_ms) = 0;
   // Asks a running local BA to stop early (a new keyframe is more useful).
   virtual void interrupt_bundle_adjustment() = 0;
   // True while the mapper is paused (e.g. loop correction): no keyframes are created then.

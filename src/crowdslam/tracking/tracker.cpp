@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <numeric>
 #include <unordered_map>
 #include <unordered_set>
@@ -97,7 +98,19 @@ TrackResult Tracker::track(map::Frame frame) {
         if (p && p->num_observations() < 1) p.reset();
       }
       temporal_points_.clear();
-      if (need_new_keyframe(frame)) {
+      KeyframeDecision decision = need_new_keyframe(frame);
+      if (decision == KeyframeDecision::kWaitForMapper) {
+        // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
+        // mapper can write its bundle adjustment back) rather than track on without new points.
+        const auto wait_start = std::chrono::steady_clock::now();
+        map_lock.unlock();
+        const bool accepting = mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
+        map_lock.lock();
+        result.waited_for_mapping_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
+        decision = accepting && !mapper_->is_paused() ? KeyframeDecision::kInsert : KeyframeDecision::kNo;
+      }
+      if (decision == KeyframeDecision::kInsert) {
         create_new_keyframe(frame);
         result.new_keyframe = true;
       }
@@ -366,14 +379,14 @@ bool Tracker::track_local_map(map::Frame& frame) {
 }
 
 // ---- keyframes ----
-bool Tracker::need_new_keyframe(const map::Frame& frame) const {
+Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) const {
   if (options_.monocular) return need_new_keyframe_monocular(frame);
-  if (mapper_->is_paused()) return false;
+  if (mapper_->is_paused()) return KeyframeDecision::kNo;
   const size_t num_keyframes = map_->num_keyframes();
   const auto max_frames = static_cast<uint64_t>(options_.max_frames_between_keyframes);
   if (last_relocalization_frame_id_ > 0 && frame.id < last_relocalization_frame_id_ + max_frames &&
       num_keyframes > max_frames) {
-    return false;
+    return KeyframeDecision::kNo;
   }
   const int min_observations = num_keyframes <= 2 ? 2 : 3;
   const int reference_matches = reference_keyframe_ ? reference_keyframe_->tracked_map_points(min_observations) : 0;
@@ -399,10 +412,12 @@ bool Tracker::need_new_keyframe(const map::Frame& frame) const {
                    mapper_idle;
   const bool c1c = inliers_in_local_map_ < reference_matches * 0.25 || need_close;
   const bool c2 = (inliers_in_local_map_ < reference_matches * ref_ratio || need_close) && inliers_in_local_map_ > 15;
-  if (!((c1a || c1b || c1c) && c2)) return false;
-  if (mapper_idle) return true;
+  if (!((c1a || c1b || c1c) && c2)) return KeyframeDecision::kNo;
+  if (mapper_idle) return KeyframeDecision::kInsert;
   mapper_->interrupt_bundle_adjustment();
-  return mapper_->queued_keyframes() < 3;
+  if (mapper_->queued_keyframes() < 3) return KeyframeDecision::kInsert;
+  // The mapper is three keyframes behind: wait only when tracking is about to fail without a keyframe.
+  return c1c && options_.max_wait_for_mapping_ms > 0 ? KeyframeDecision::kWaitForMapper : KeyframeDecision::kNo;
 }
 
 void Tracker::create_new_keyframe(map::Frame& frame) {
@@ -411,7 +426,9 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
                                                   frame.levels, frame.features, *frame.cam_from_world);
   // The keyframe takes the frame's current matches (the mapper adds the observations).
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    if (frame.map_points[i] && !frame.outliers[i]) keyframe->add_map_point(i, frame.map_points[i]);
+    if (frame.map_points[i] && !frame.outliers[i] && !frame.map_points[i]->is_bad()) {
+      keyframe->add_map_point(i, frame.map_points[i]);
+    }
   }
   // New points from the closest depth measurements without a map point.
   const auto& f = *frame.features;

@@ -28,6 +28,10 @@ struct TrackerOptions {
   double close_depth_m = 3.0;         // "close" points (ThDepth * baseline): reliable depth
   int min_init_features = 500;        // keypoints with depth needed to initialise (RGB-D)
   int max_frames_between_keyframes = 30;  // usually the camera fps
+  // Backpressure: when a keyframe is needed urgently and local mapping is behind, tracking waits for it
+  // up to this long (with the map unlocked) instead of going on without the keyframe and losing track.
+  // 0 = never wait (ORB-SLAM2's behaviour). Sequential mode never needs to wait.
+  double max_wait_for_mapping_ms = 1000.0;
   int min_frames_between_keyframes = 0;
   double motion_model_radius = 15.0;  // px at level 0 for the motion-model projection search
   double keyframe_window_radius = 50.0;
@@ -55,6 +59,7 @@ struct TrackResult {
   int tracked_points = 0;   // inliers after local-map tracking
   int keypoints = 0;
   const char* method = "";  // "init", "motion", "reference", "relocalization", "lost"
+  double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
 };
 
 class Tracker {
@@ -78,7 +83,8 @@ class Tracker {
  private:
   bool initialize(map::Frame& frame);
   bool initialize_monocular(map::Frame& frame);                   // tracker_monocular.cpp
-  bool need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
+  enum class KeyframeDecision { kNo, kInsert, kWaitForMapper };
+  KeyframeDecision need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);
   bool track_reference_keyframe(map::Frame& frame);
   bool track_local_map(map::Frame& frame);
@@ -87,7 +93,7 @@ class Tracker {
   void replace_replaced_points(map::Frame& frame) const;
   void update_local_map(const map::Frame& frame);
   int optimize_pose(map::Frame& frame) const;
-  bool need_new_keyframe(const map::Frame& frame) const;
+  KeyframeDecision need_new_keyframe(const map::Frame& frame) const;
   void create_new_keyframe(map::Frame& frame);
   std::shared_ptr<map::MapPoint> make_point_from_depth(const map::Frame& frame, size_t index,
                                                        const std::shared_ptr<map::KeyFrame>& keyframe) const;

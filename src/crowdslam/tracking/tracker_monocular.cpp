@@ -40,18 +40,21 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
   return true;
 }
 
-bool Tracker::need_new_keyframe_monocular(const map::Frame& frame) const {
+Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame& frame) const {
   // ORB-SLAM2, monocular: a keyframe when the frame tracks less than 90 % of the reference keyframe's
   // points (40 % while the map has one keyframe) and either enough frames have passed or the mapper is
   // idle. No "close points" condition (there is no depth) and no insertion while the mapper is busy:
-  // then its bundle adjustment is interrupted so that it becomes free sooner.
+  // then its bundle adjustment is interrupted so that it becomes free sooner. Unlike ORB-SLAM2, when
+  // the keyframe is overdue (max_frames passed) or the frame tracks less than half the reference's
+  // points, tracking waits for the mapper (backpressure) instead of running out of map points.
   constexpr double kReferenceRatio = 0.9;
-  if (mapper_->is_paused()) return false;
+  constexpr double kUrgentRatio = 0.5;
+  if (mapper_->is_paused()) return KeyframeDecision::kNo;
   const size_t num_keyframes = map_->num_keyframes();
   const auto max_frames = static_cast<uint64_t>(options_.max_frames_between_keyframes);
   if (last_relocalization_frame_id_ > 0 && frame.id < last_relocalization_frame_id_ + max_frames &&
       num_keyframes > max_frames) {
-    return false;
+    return KeyframeDecision::kNo;
   }
   const int min_observations = num_keyframes <= 2 ? 2 : 3;
   const int reference_matches =
@@ -63,10 +66,11 @@ bool Tracker::need_new_keyframe_monocular(const map::Frame& frame) const {
       frame.id >= last_keyframe_frame_id_ + static_cast<uint64_t>(options_.min_frames_between_keyframes) &&
       mapper_idle;
   const bool c2 = inliers_in_local_map_ < reference_matches * ratio && inliers_in_local_map_ > 15;
-  if (!((c1a || c1b) && c2)) return false;
-  if (mapper_idle) return true;
+  if (!c2) return KeyframeDecision::kNo;
+  if (mapper_idle && (c1a || c1b)) return KeyframeDecision::kInsert;
   mapper_->interrupt_bundle_adjustment();
-  return false;
+  const bool urgent = c1a || inliers_in_local_map_ < reference_matches * kUrgentRatio;
+  return urgent && options_.max_wait_for_mapping_ms > 0 ? KeyframeDecision::kWaitForMapper : KeyframeDecision::kNo;
 }
 
 }  // namespace crowdslam::tracking
