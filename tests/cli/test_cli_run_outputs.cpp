@@ -227,3 +227,22 @@ TEST(CliRunOutputs, SavedFramesAreWrittenWhileTheRunGoesOn) {
   const cv::Mat frame = cv::imread((out / "frames" / "000299.jpg").string());
   EXPECT_EQ(frame.cols, 320);
 }
+
+TEST(CliRunOutputs, DepthImagesWithoutAnyDepthAreWarnedAndCounted) {
+  TempDir dir;
+  const auto seq = synth_small(dir, 10);
+  const cv::Mat zero(240, 320, CV_16UC1, cv::Scalar(0));
+  for (int i = 3; i <= 6; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    ASSERT_TRUE(cv::imwrite((seq / "depth" / name).string(), zero));
+  }
+  const auto out = dir / "out";
+  const auto r = run_cli(run_args(seq, out, {"--sequential"}));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("depth/000003.png"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("without any valid depth"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4 frames had no valid depth"), std::string::npos) << r.err;
+  const auto doc = read_json(out / "run.json");
+  EXPECT_EQ(doc["input"]["empty_depth_frames"], 4);
+}
