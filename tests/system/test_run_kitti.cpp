@@ -1,0 +1,36 @@
+// Monocular SLAM on real forward motion (issue 11): KITTI odometry 07, the first 100 frames (a car
+// accelerating to 8.5 m/s through a town), in sequential mode so the run is reproducible. The map is
+// initialised once and never reset, every frame from the initialisation on is tracked, and the Sim3 ATE
+// stays within 0.65 % of the 54 m travelled (the issue's target for the threaded mode is 0.5 %, 0.27 m:
+// not met yet, see docs/RESULTS.md).
+#include <gtest/gtest.h>
+
+#include "crowdslam/run/run_sequence.h"
+#include "test_support.h"
+
+using namespace crowdslam;
+
+TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  run::RunOptions options;
+  options.dataset = test::shared_data("kitti07_head").string();
+  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
+  options.out_dir = (tmp / "out").string();
+  options.sensor = io::SensorKind::kMonocular;
+  options.sequential = true;
+  options.progress = false;
+  options.people_filter = false;
+  const auto summary = run::run_sequence(options);
+  ASSERT_TRUE(summary.init_frame.has_value());
+  EXPECT_LE(*summary.init_frame, 10u);
+  EXPECT_EQ(summary.json["summary"]["map_resets"], 0);
+  EXPECT_EQ(summary.segments.size(), 1u);
+  // From the initialisation on (and its reference frame), every frame.
+  EXPECT_EQ(summary.tracked, summary.frames - *summary.init_frame + 1);
+  EXPECT_GE(summary.tracked_percent, 95.0);
+  ASSERT_TRUE(summary.ate_rmse_m.has_value());
+  EXPECT_LT(*summary.ate_rmse_m, 0.35);
+  std::printf("[ measured ] kitti07_head sequential: %zu/%zu tracked, ATE %.3f m, %d keyframes\n", summary.tracked,
+              summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>());
+}
