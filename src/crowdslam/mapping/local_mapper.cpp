@@ -189,8 +189,11 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
   const double fusion_ms = ms_since(t);
   abort_ba_ = false;
   double culling_ms = 0;
+  double ba_ms = 0;
   if (!has_new_keyframes() && !pause_requested_ && !stopping_now_) {
+    t = Clock::now();
     if (options_.local_ba && map_->num_keyframes() > 2) run_local_bundle_adjustment(keyframe);
+    ba_ms = ms_since(t);
     t = Clock::now();
     cull_keyframes(keyframe);
     culling_ms = ms_since(t);
@@ -205,7 +208,9 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
   stats_.triangulation_ms_total += triangulation_ms;
   stats_.fusion_ms_total += fusion_ms;
   stats_.culling_ms_total += culling_ms;
-  stats_.processing_ms_total += ms_since(start);
+  const double total_ms = ms_since(start);
+  stats_.processing_ms_total += total_ms;
+  stats_.per_keyframe.push_back({register_ms, triangulation_ms, fusion_ms, ba_ms, culling_ms, total_ms});
 }
 
 void LocalMapper::register_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe) {

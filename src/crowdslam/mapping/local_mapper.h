@@ -42,6 +42,16 @@ struct LocalMapperOptions {
   void check() const;
 };
 
+// Time of each step for one keyframe (ms); ba_ms is 0 when local BA did not run for it.
+struct KeyframeStepTimes {
+  double register_ms = 0;
+  double triangulation_ms = 0;
+  double fusion_ms = 0;
+  double ba_ms = 0;
+  double culling_ms = 0;
+  double total_ms = 0;
+};
+
 struct LocalMapperStats {
   int keyframes_processed = 0;
   int points_created = 0;
@@ -56,6 +66,7 @@ struct LocalMapperStats {
   double fusion_ms_total = 0;
   double culling_ms_total = 0;
   double processing_ms_total = 0;
+  std::vector<KeyframeStepTimes> per_keyframe;  // in processing order (for medians and p95)
 };
 
 class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMappingControl {

@@ -240,6 +240,19 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                           {"fusion_ms_mean", mapper.fusion_ms_total / processed},
                           {"culling_ms_mean", mapper.culling_ms_total / processed},
                           {"keyframe_ms_mean", mapper.processing_ms_total / processed}};
+  // Per keyframe: median and p95 of each step and of the whole.
+  const auto step = [&](double mapping::KeyframeStepTimes::*field) {
+    std::vector<double> values;
+    values.reserve(mapper.per_keyframe.size());
+    for (const auto& k : mapper.per_keyframe) values.push_back(k.*field);
+    return nlohmann::json{{"median", percentile(values, 0.5)}, {"p95", percentile(values, 0.95)}};
+  };
+  doc["local_mapping"]["per_keyframe_ms"] = {{"register", step(&mapping::KeyframeStepTimes::register_ms)},
+                                             {"triangulation", step(&mapping::KeyframeStepTimes::triangulation_ms)},
+                                             {"fusion", step(&mapping::KeyframeStepTimes::fusion_ms)},
+                                             {"local_ba", step(&mapping::KeyframeStepTimes::ba_ms)},
+                                             {"culling", step(&mapping::KeyframeStepTimes::culling_ms)},
+                                             {"total", step(&mapping::KeyframeStepTimes::total_ms)}};
   if (slam.loop_closing_enabled()) {
     const auto loops = slam.loop_stats();
     nlohmann::json events = nlohmann::json::array();
