@@ -81,24 +81,8 @@ TEST(CliDataset, CheckFindsATruncatedDepthMapThatInfoAloneDoesNotRead) {
   CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
   // Two real Bonn frames copied into a temporary TUM layout; the second depth map is cut in half.
   namespace fs = std::filesystem;
-  const fs::path bonn = shared_data("bonn_crowd");
   crowdslam::test::TempDir dir;
-  fs::create_directories(dir / "rgb");
-  fs::create_directories(dir / "depth");
-  const char* rgb[] = {"1548339819.87426", "1548339819.90761"};
-  const char* depth[] = {"1548339819.88851", "1548339819.92187"};
-  std::string rgb_list, depth_list;
-  for (int i = 0; i < 2; ++i) {
-    fs::copy_file(bonn / "rgb" / (std::string(rgb[i]) + ".jpg"),
-                  dir / "rgb" / (std::string(rgb[i]) + ".jpg"));
-    fs::copy_file(bonn / "depth" / (std::string(depth[i]) + ".png"),
-                  dir / "depth" / (std::string(depth[i]) + ".png"));
-    rgb_list += std::string(rgb[i]) + " rgb/" + rgb[i] + ".jpg\n";
-    depth_list += std::string(depth[i]) + " depth/" + depth[i] + ".png\n";
-  }
-  crowdslam::test::write_text(dir / "rgb.txt", rgb_list);
-  crowdslam::test::write_text(dir / "depth.txt", depth_list);
-  const fs::path cut = dir / "depth" / (std::string(depth[1]) + ".png");
+  const fs::path cut = crowdslam::test::copy_two_bonn_frames(dir.path()).depth[1];
   fs::resize_file(cut, fs::file_size(cut) / 2);
 
   const auto info = run_cli({"dataset", "info", dir.path().string(), "--json"});

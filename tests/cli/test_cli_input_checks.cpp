@@ -45,27 +45,6 @@ void make_tum(const fs::path& dir) {
   write_text(dir / "depth.txt", "0.0 depth/0.png\n1.0 depth/1.png\n");
 }
 
-// Two real Bonn frames in a temporary TUM layout; returns the second colour image's path.
-fs::path copy_two_bonn_frames(const fs::path& dir) {
-  const fs::path bonn = shared_data("bonn_crowd");
-  fs::create_directories(dir / "rgb");
-  fs::create_directories(dir / "depth");
-  const char* rgb[] = {"1548339819.87426", "1548339819.90761"};
-  const char* depth[] = {"1548339819.88851", "1548339819.92187"};
-  std::string rgb_list, depth_list;
-  for (int i = 0; i < 2; ++i) {
-    fs::copy_file(bonn / "rgb" / (std::string(rgb[i]) + ".jpg"),
-                  dir / "rgb" / (std::string(rgb[i]) + ".jpg"));
-    fs::copy_file(bonn / "depth" / (std::string(depth[i]) + ".png"),
-                  dir / "depth" / (std::string(depth[i]) + ".png"));
-    rgb_list += std::string(rgb[i]) + " rgb/" + rgb[i] + ".jpg\n";
-    depth_list += std::string(depth[i]) + " depth/" + depth[i] + ".png\n";
-  }
-  write_text(dir / "rgb.txt", rgb_list);
-  write_text(dir / "depth.txt", depth_list);
-  return dir / "rgb" / (std::string(rgb[1]) + ".jpg");
-}
-
 std::vector<char> bytes_of(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -90,7 +69,7 @@ TEST(CliInput, ListFileGivenAsTheDatasetAsksForTheDirectory) {
 TEST(CliInput, CheckFailsOnACutBonnJpegThatStillEndsWithTheEndMarker) {
   CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
   TempDir dir;
-  const fs::path second = copy_two_bonn_frames(dir.path());
+  const fs::path second = crowdslam::test::copy_two_bonn_frames(dir.path()).colour[1];
   std::vector<char> jpeg = bytes_of(second);
   jpeg.resize(jpeg.size() / 2);
   jpeg.push_back(static_cast<char>(0xFF));
@@ -106,7 +85,7 @@ TEST(CliInput, CheckFailsOnACutBonnJpegThatStillEndsWithTheEndMarker) {
 TEST(CliInput, CheckFailsOnFlippedBitsInABonnJpeg) {
   CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
   TempDir dir;
-  const fs::path second = copy_two_bonn_frames(dir.path());
+  const fs::path second = crowdslam::test::copy_two_bonn_frames(dir.path()).colour[1];
   std::vector<char> jpeg = bytes_of(second);
   // 64 bytes: a single flipped bit often decodes without complaint (JPEG has no checksum).
   for (std::size_t i = jpeg.size() / 2; i < jpeg.size() / 2 + 64; ++i)

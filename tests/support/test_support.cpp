@@ -134,6 +134,28 @@ CliResult CliProcess::wait(double timeout_s) {
   return result;
 }
 
+TwoBonnFrames copy_two_bonn_frames(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  const fs::path bonn = shared_data("bonn_crowd");
+  fs::create_directories(dir / "rgb");
+  fs::create_directories(dir / "depth");
+  const char* rgb[] = {"1548339819.87426", "1548339819.90761"};
+  const char* depth[] = {"1548339819.88851", "1548339819.92187"};
+  TwoBonnFrames frames;
+  std::string rgb_list, depth_list;
+  for (int i = 0; i < 2; ++i) {
+    frames.colour[i] = dir / "rgb" / (std::string(rgb[i]) + ".jpg");
+    frames.depth[i] = dir / "depth" / (std::string(depth[i]) + ".png");
+    fs::copy_file(bonn / "rgb" / frames.colour[i].filename(), frames.colour[i]);
+    fs::copy_file(bonn / "depth" / frames.depth[i].filename(), frames.depth[i]);
+    rgb_list += std::string(rgb[i]) + " rgb/" + rgb[i] + ".jpg\n";
+    depth_list += std::string(depth[i]) + " depth/" + depth[i] + ".png\n";
+  }
+  write_text(dir / "rgb.txt", rgb_list);
+  write_text(dir / "depth.txt", depth_list);
+  return frames;
+}
+
 CliResult run_cli(const std::vector<std::string>& args) {
   CliProcess child(args);
   return child.wait(3600);

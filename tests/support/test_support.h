@@ -35,6 +35,13 @@ class TempDir {
 void write_text(const std::filesystem::path& path, const std::string& content);
 std::string read_text(const std::filesystem::path& path);
 
+// Two real bonn_crowd frames (colour and depth) copied into `dir` in TUM layout (rgb.txt, depth.txt).
+struct TwoBonnFrames {
+  std::filesystem::path colour[2];
+  std::filesystem::path depth[2];
+};
+TwoBonnFrames copy_two_bonn_frames(const std::filesystem::path& dir);
+
 struct CliResult {
   int exit_code = -1;
   std::string out;

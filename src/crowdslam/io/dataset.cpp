@@ -69,9 +69,9 @@ FrameImages Dataset::load(std::size_t index) const {
     const auto text = [](const cv::Size& s) {
       return std::to_string(s.width) + "x" + std::to_string(s.height);
     };
-    throw input_error(clipped(info.colour_path),
+    throw input_error(clip_text(info.colour_path),
                       "colour image is " + text(images.colour.size()) + ", but the first frame's (" +
-                          clipped(contents_.frames.front().colour_path) + ") is " + text(*expected) +
+                          clip_text(contents_.frames.front().colour_path) + ") is " + text(*expected) +
                           "; every frame of a sequence must have the same size");
   }
   if (!info.depth_path.empty()) {

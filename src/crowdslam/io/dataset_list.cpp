@@ -17,19 +17,19 @@ namespace {
 std::vector<std::string> lines_of(const std::string& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (status.type() == fs::file_type::not_found) throw input_error(clipped(path), "list file does not exist");
-  if (ec) throw input_error(clipped(path), "cannot access list file: " + ec.message());
-  if (!fs::is_regular_file(status)) throw input_error(clipped(path), "list file is not a regular file");
+  if (status.type() == fs::file_type::not_found) throw input_error(clip_text(path), "list file does not exist");
+  if (ec) throw input_error(clip_text(path), "cannot access list file: " + ec.message());
+  if (!fs::is_regular_file(status)) throw input_error(clip_text(path), "list file is not a regular file");
   return read_lines(path);
 }
 
 double parse_stamp(const std::string& field, const std::string& path, int line) {
   const auto value = parse_double(field);
   if (!value || !std::isfinite(*value))
-    throw input_error(clipped(path), line, "timestamp '" + clipped(field) + "' is not a finite number");
+    throw input_error(clip_text(path), line, "timestamp '" + clip_text(field) + "' is not a finite number");
   if (*value < 0 || *value >= kMaxTimestampS)
-    throw input_error(clipped(path), line,
-                      "timestamp '" + clipped(field) + "' is out of range (expected seconds in [0, 1e11))");
+    throw input_error(clip_text(path), line,
+                      "timestamp '" + clip_text(field) + "' is out of range (expected seconds in [0, 1e11))");
   return *value;
 }
 
@@ -48,11 +48,11 @@ std::vector<ListEntry> read_tum_list(const std::string& path) {
     const int line = static_cast<int>(i + 1);
     const auto fields = split_fields(lines[i], false);
     if (fields.size() < 2)
-      throw input_error(clipped(path), line,
-                        "expected 'timestamp filename', got '" + clipped(trim(lines[i])) + "'");
+      throw input_error(clip_text(path), line,
+                        "expected 'timestamp filename', got '" + clip_text(trim(lines[i])) + "'");
     entries.push_back({parse_stamp(fields[0], path, line), 0, fields[1], line});
   }
-  if (entries.empty()) throw input_error(clipped(path), "list is empty");
+  if (entries.empty()) throw input_error(clip_text(path), "list is empty");
   return entries;
 }
 
@@ -64,18 +64,18 @@ std::vector<ListEntry> read_euroc_list(const std::string& path) {
     const int line = static_cast<int>(i + 1);
     const auto fields = split_fields(lines[i], true);
     if (fields.size() < 2)
-      throw input_error(clipped(path), line,
-                        "expected 'timestamp_ns,filename', got '" + clipped(trim(lines[i])) + "'");
+      throw input_error(clip_text(path), line,
+                        "expected 'timestamp_ns,filename', got '" + clip_text(trim(lines[i])) + "'");
     const auto ns = parse_int(fields[0]);
     if (!ns || *ns < 0)
-      throw input_error(clipped(path), line,
-                        "timestamp '" + clipped(fields[0]) + "' is not a non-negative integer number of ns");
+      throw input_error(clip_text(path), line,
+                        "timestamp '" + clip_text(fields[0]) + "' is not a non-negative integer number of ns");
     // Seconds and nanoseconds apart, as io::read_euroc_trajectory does, so equal ns give equal doubles.
     const double stamp_s =
         static_cast<double>(*ns / 1000000000LL) + static_cast<double>(*ns % 1000000000LL) * 1e-9;
     entries.push_back({stamp_s, *ns, fields[1], line});
   }
-  if (entries.empty()) throw input_error(clipped(path), "list is empty");
+  if (entries.empty()) throw input_error(clip_text(path), "list is empty");
   return entries;
 }
 
@@ -87,10 +87,10 @@ std::vector<ListEntry> read_times_list(const std::string& path) {
     const int line = static_cast<int>(i + 1);
     const auto fields = split_fields(lines[i], false);
     if (fields.size() != 1)
-      throw input_error(clipped(path), line, "expected one timestamp, got '" + clipped(trim(lines[i])) + "'");
+      throw input_error(clip_text(path), line, "expected one timestamp, got '" + clip_text(trim(lines[i])) + "'");
     stamps.push_back({parse_stamp(fields[0], path, line), 0, {}, line});
   }
-  if (stamps.empty()) throw input_error(clipped(path), "list is empty");
+  if (stamps.empty()) throw input_error(clip_text(path), "list is empty");
   return stamps;
 }
 
@@ -98,10 +98,10 @@ void require_listed_file(const std::string& file, const std::string& list, int l
   std::error_code ec;
   const fs::file_status status = fs::status(file, ec);
   if (status.type() == fs::file_type::not_found)
-    throw input_error(clipped(list), line, "listed image " + clipped(file) + " does not exist");
-  if (ec) throw input_error(clipped(list), line, "listed image " + clipped(file) + ": " + ec.message());
+    throw input_error(clip_text(list), line, "listed image " + clip_text(file) + " does not exist");
+  if (ec) throw input_error(clip_text(list), line, "listed image " + clip_text(file) + ": " + ec.message());
   if (!fs::is_regular_file(status))
-    throw input_error(clipped(list), line, "listed image " + clipped(file) + " is not a regular file");
+    throw input_error(clip_text(list), line, "listed image " + clip_text(file) + " is not a regular file");
 }
 
 std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& entries,
@@ -134,7 +134,7 @@ std::vector<ListEntry> without_duplicate_stamps(const std::vector<ListEntry>& en
     spdlog::warn(
         "{}:{}: {} entr{} repeat a time stamp listed before (the first repeats line {}); of equal "
         "stamps the later entry is used, the earlier skipped (as TUM's associate.py does)",
-        clipped(list), first_repeat, duplicates, duplicates == 1 ? "y" : "ies", first_original);
+        clip_text(list), first_repeat, duplicates, duplicates == 1 ? "y" : "ies", first_original);
   std::vector<ListEntry> kept;
   kept.reserve(entries.size() - duplicates);
   if (by_ns) {

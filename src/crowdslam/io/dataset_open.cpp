@@ -57,11 +57,11 @@ void refuse_text_file(const std::string& spec) {
   if (ec) parent = fs::path(spec).parent_path();
   const std::string name = fs::path(spec).filename().string();
   const bool list = ext == ".txt" || ext == ".csv";
-  const std::string what = list ? "is a list file (" + clipped(name) + "), not a dataset or a video"
+  const std::string what = list ? "is a list file (" + clip_text(name) + "), not a dataset or a video"
                                 : "is a text file, not a dataset directory or a video";
-  std::string hint = "; pass the dataset directory (its parent, " + clipped(parent.string()) + ") instead";
+  std::string hint = "; pass the dataset directory (its parent, " + clip_text(parent.string()) + ") instead";
   if (ext == ".yaml" || ext == ".yml") hint += " (settings files go to --settings)";
-  throw input_error(clipped(spec), what + hint);
+  throw input_error(clip_text(spec), what + hint);
 }
 
 }  // namespace
@@ -70,14 +70,14 @@ std::unique_ptr<Dataset> open_dataset(const std::string& directory, const Datase
   options.check();
   std::error_code ec;
   const fs::file_status status = fs::status(directory, ec);
-  if (status.type() == fs::file_type::not_found) throw input_error(clipped(directory), "no such directory");
-  if (ec) throw input_error(clipped(directory), "cannot access: " + ec.message());
-  if (!fs::is_directory(status)) throw input_error(clipped(directory), "not a directory");
+  if (status.type() == fs::file_type::not_found) throw input_error(clip_text(directory), "no such directory");
+  if (ec) throw input_error(clip_text(directory), "cannot access: " + ec.message());
+  if (!fs::is_directory(status)) throw input_error(clip_text(directory), "not a directory");
   if (looks_like_tum(directory)) return open_tum_dataset(directory, options);
   if (looks_like_euroc(directory)) return open_euroc_dataset(directory, options);
   if (looks_like_kitti(directory)) return open_kitti_dataset(directory, options);
   if (looks_like_image_folder(directory)) return open_image_folder_dataset(directory, options);
-  throw input_error(clipped(directory),
+  throw input_error(clip_text(directory),
                     "unknown dataset layout (expected rgb.txt (TUM), mav0/cam0/data.csv (EuRoC), "
                     "times.txt + image_0/ (KITTI) or image files)");
 }
@@ -91,14 +91,14 @@ std::unique_ptr<FrameSource> open_source(const std::string& spec, const DatasetO
   if (all_digits && status.type() == fs::file_type::not_found)
     return VideoSource::open_camera(std::stoi(spec), options);
   if (status.type() == fs::file_type::not_found)
-    throw input_error(clipped(spec), "no such file or directory");
-  if (ec) throw input_error(clipped(spec), "cannot access: " + ec.message());
+    throw input_error(clip_text(spec), "no such file or directory");
+  if (ec) throw input_error(clip_text(spec), "cannot access: " + ec.message());
   if (fs::is_directory(status)) return open_dataset(spec, options);
   if (fs::is_regular_file(status)) {
     refuse_text_file(spec);
     return VideoSource::open_file(spec, options);
   }
-  throw input_error(clipped(spec), "not a directory, a video file or a camera index");
+  throw input_error(clip_text(spec), "not a directory, a video file or a camera index");
 }
 
 }  // namespace crowdslam::io

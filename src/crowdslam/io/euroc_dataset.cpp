@@ -89,8 +89,8 @@ void warn_unpaired(const std::map<long long, ListEntry>& left, const std::map<lo
   std::size_t right_only = 0;
   for (const auto& [ns, entry] : right) right_only += left.count(ns) ? 0 : 1;
   if (left_only == 0 && right_only == 0) return;
-  const std::string left_list = clipped((mav0 / "cam0" / "data.csv").string());
-  const std::string right_list = clipped((mav0 / "cam1" / "data.csv").string());
+  const std::string left_list = clip_text((mav0 / "cam0" / "data.csv").string());
+  const std::string right_list = clip_text((mav0 / "cam1" / "data.csv").string());
   if (left_only > 0) {
     spdlog::warn(
         "{}:{}: {} of {} left images have no right image with the same time stamp in {}; stereo skips "
@@ -107,7 +107,7 @@ void warn_unpaired(const std::map<long long, ListEntry>& left, const std::map<lo
 
 EurocCameraCalibration read_euroc_camera_calibration(const std::string& sensor_yaml) {
   if (!regular_file_exists(sensor_yaml))
-    throw input_error(clipped(sensor_yaml), "calibration file does not exist");
+    throw input_error(clip_text(sensor_yaml), "calibration file does not exist");
   try {
     cv::FileStorage storage(sensor_yaml, cv::FileStorage::READ);
     if (!storage.isOpened()) throw input_error(sensor_yaml, "cannot open calibration file");
@@ -147,7 +147,7 @@ std::unique_ptr<EurocDataset> open_euroc_dataset(const std::string& directory,
         c.frames.push_back({c.frames.size(), entry.timestamp_s, entry.file, {}, match->second.file});
     }
     if (c.frames.empty())
-      throw input_error(clipped((mav0 / "cam1" / "data.csv").string()), "no timestamp in common with cam0");
+      throw input_error(clip_text((mav0 / "cam1" / "data.csv").string()), "no timestamp in common with cam0");
     warn_unpaired(left, right, mav0);
   } else {
     c.sensor = SensorKind::kMonocular;

@@ -23,20 +23,20 @@ std::vector<unsigned char> read_image_bytes(const std::string& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (status.type() == fs::file_type::not_found)
-    throw input_error(clipped(path), "image file does not exist");
-  if (ec) throw input_error(clipped(path), "cannot access image file: " + ec.message());
-  if (!fs::is_regular_file(status)) throw input_error(clipped(path), "image path is not a regular file");
+    throw input_error(clip_text(path), "image file does not exist");
+  if (ec) throw input_error(clip_text(path), "cannot access image file: " + ec.message());
+  if (!fs::is_regular_file(status)) throw input_error(clip_text(path), "image path is not a regular file");
   const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) throw input_error(clipped(path), "cannot read image file size: " + ec.message());
-  if (size == 0) throw input_error(clipped(path), "image file is empty");
+  if (ec) throw input_error(clip_text(path), "cannot read image file size: " + ec.message());
+  if (size == 0) throw input_error(clip_text(path), "image file is empty");
   if (size > kMaxImageFileBytes)
-    throw input_error(clipped(path), "image file of " + std::to_string(size) + " bytes is too large");
+    throw input_error(clip_text(path), "image file of " + std::to_string(size) + " bytes is too large");
   std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
   std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) throw input_error(clipped(path), "cannot open image file");
+  if (file == nullptr) throw input_error(clip_text(path), "cannot open image file");
   const std::size_t read = std::fread(bytes.data(), 1, bytes.size(), file);
   std::fclose(file);
-  if (read != bytes.size()) throw input_error(clipped(path), "read error (file changed while reading?)");
+  if (read != bytes.size()) throw input_error(clip_text(path), "read error (file changed while reading?)");
   return bytes;
 }
 
@@ -98,17 +98,17 @@ void check_png_chunks(const std::vector<unsigned char>& bytes, const std::string
   while (true) {
     const std::string at = " at byte " + std::to_string(pos);
     if (pos + 12 > bytes.size())
-      throw input_error(clipped(path), "truncated PNG image (ends" + at + " before the IEND chunk)");
+      throw input_error(clip_text(path), "truncated PNG image (ends" + at + " before the IEND chunk)");
     const unsigned char* chunk = bytes.data() + pos;
     const std::uint32_t length = load_be32(chunk);
     if (length > 0x7FFFFFFFu || !is_chunk_type(chunk + 4))
-      throw input_error(clipped(path), "corrupt PNG image (bad chunk header" + at + ")");
+      throw input_error(clip_text(path), "corrupt PNG image (bad chunk header" + at + ")");
     const std::string type(reinterpret_cast<const char*>(chunk + 4), 4);
     if (pos + 12 + length > bytes.size())
-      throw input_error(clipped(path), "truncated PNG image (chunk " + type + at + " is cut off)");
+      throw input_error(clip_text(path), "truncated PNG image (chunk " + type + at + " is cut off)");
     if (load_be32(chunk + 8 + length) != crc32(chunk + 4, 4 + length))
-      throw input_error(clipped(path), "corrupt PNG image (CRC error in chunk " + type + at + ")");
-    if (first && type != "IHDR") throw input_error(clipped(path), "corrupt PNG image (no IHDR chunk first)");
+      throw input_error(clip_text(path), "corrupt PNG image (CRC error in chunk " + type + at + ")");
+    if (first && type != "IHDR") throw input_error(clip_text(path), "corrupt PNG image (no IHDR chunk first)");
     first = false;
     if (type == "IEND") return;
     pos += 12 + length;
@@ -126,9 +126,9 @@ cv::Mat decode(const std::string& path, int flags) {
   try {
     image = cv::imdecode(bytes, flags);
   } catch (const cv::Exception& e) {
-    throw input_error(clipped(path), std::string("cannot decode image: ") + e.what());
+    throw input_error(clip_text(path), std::string("cannot decode image: ") + e.what());
   }
-  if (image.empty()) throw input_error(clipped(path), "cannot decode image (unknown format or corrupt file)");
+  if (image.empty()) throw input_error(clip_text(path), "cannot decode image (unknown format or corrupt file)");
   return image;
 }
 
@@ -139,7 +139,7 @@ cv::Mat read_colour_image(const std::string& path) { return decode(path, cv::IMR
 cv::Mat read_depth_image(const std::string& path) {
   cv::Mat depth = decode(path, cv::IMREAD_UNCHANGED);
   if (depth.type() != CV_16UC1) {
-    throw input_error(clipped(path), "depth image must be 16-bit single-channel (got " +
+    throw input_error(clip_text(path), "depth image must be 16-bit single-channel (got " +
                                          std::to_string(depth.channels()) + " channel(s) of " +
                                          std::to_string(8 * static_cast<int>(depth.elemSize1())) + "-bit)");
   }
@@ -149,7 +149,7 @@ cv::Mat read_depth_image(const std::string& path) {
 void check_same_size(const cv::Mat& image, const cv::Size& expected, const std::string& path,
                      const std::string& what) {
   if (image.size() == expected) return;
-  throw input_error(clipped(path), what + " is " + std::to_string(image.cols) + "x" +
+  throw input_error(clip_text(path), what + " is " + std::to_string(image.cols) + "x" +
                                        std::to_string(image.rows) + ", expected " +
                                        std::to_string(expected.width) + "x" +
                                        std::to_string(expected.height));

@@ -26,18 +26,18 @@ std::vector<std::string> image_files(const std::string& directory, bool warn) {
     std::error_code entry_ec;
     const fs::file_status status = fs::status(it->path(), entry_ec);
     if (entry_ec && status.type() != fs::file_type::not_found)  // not found: a dangling symlink, skipped
-      throw input_error(clipped(it->path().string()), "cannot read image entry: " + entry_ec.message());
+      throw input_error(clip_text(it->path().string()), "cannot read image entry: " + entry_ec.message());
     if (fs::is_regular_file(status)) {
       files.push_back(it->path().string());
     } else if (skipped++ == 0) {
       first_skipped = it->path().string();
     }
   }
-  if (ec) throw input_error(clipped(directory), "cannot list directory: " + ec.message());
+  if (ec) throw input_error(clip_text(directory), "cannot list directory: " + ec.message());
   if (warn && skipped > 0)
     spdlog::warn(
         "{}: {} entr{} with an image name but not a regular file (a folder, a dangling link) skipped",
-        clipped(first_skipped), skipped, skipped == 1 ? "y" : "ies");
+        clip_text(first_skipped), skipped, skipped == 1 ? "y" : "ies");
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -58,7 +58,7 @@ std::unique_ptr<Dataset> open_image_folder_dataset(const std::string& directory,
                                                    const DatasetOptions& options) {
   options.check();
   const auto files = image_files(directory, true);
-  if (files.empty()) throw input_error(clipped(directory), "no image files in folder");
+  if (files.empty()) throw input_error(clip_text(directory), "no image files in folder");
   DatasetContents c;
   c.directory = directory;
   c.layout = "images";

@@ -5,15 +5,6 @@
 
 namespace crowdslam::io {
 
-std::string clipped(std::string_view text, std::size_t max_chars) {
-  if (text.size() <= max_chars) return std::string(text);
-  const std::string suffix = " (" + std::to_string(text.size()) + " chars)";
-  const std::size_t room = max_chars > suffix.size() + 3 + 2 ? max_chars - suffix.size() - 3 : 2;
-  const std::size_t tail = room / 3;
-  const std::size_t head = room - tail;
-  return std::string(text.substr(0, head)) + "..." + std::string(text.substr(text.size() - tail)) + suffix;
-}
-
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> row(b.size() + 1);
   for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;

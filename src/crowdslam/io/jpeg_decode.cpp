@@ -197,14 +197,14 @@ cv::Mat decode_jpeg(const unsigned char* data, std::size_t size, const std::stri
   }
   jpeg_destroy_decompress(&job.cinfo);
   if (job.too_large)
-    throw input_error(clipped(path), "JPEG image of " + std::to_string(job.width) + "x" +
+    throw input_error(clip_text(path), "JPEG image of " + std::to_string(job.width) + "x" +
                                          std::to_string(job.height) + " pixels is too large");
   if (!ok) {
     const bool truncated = job.err.code == JWRN_JPEG_EOF || job.err.code == JERR_INPUT_EOF;
     const std::string what = truncated         ? "truncated JPEG image: "
                              : job.err.warning ? "corrupt JPEG image: "
                                                : "cannot decode JPEG image: ";
-    throw input_error(clipped(path), what + job.err.message);
+    throw input_error(clip_text(path), what + job.err.message);
   }
   if (!cmyk.empty()) cmyk_to_bgr(cmyk, out);
   apply_orientation(out, job.orientation);

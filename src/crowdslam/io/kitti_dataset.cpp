@@ -30,8 +30,8 @@ std::map<std::string, std::vector<double>> read_projections(const std::string& p
     const int line = static_cast<int>(i + 1);
     const auto fields = split_fields(lines[i], false);
     if (fields[0].empty() || fields[0].back() != ':')
-      throw input_error(clipped(path), line,
-                        "expected 'NAME: numbers', got '" + clipped(trim(lines[i])) + "'");
+      throw input_error(clip_text(path), line,
+                        "expected 'NAME: numbers', got '" + clip_text(trim(lines[i])) + "'");
     const std::string name = fields[0].substr(0, fields[0].size() - 1);
     if (name.size() != 2 || name[0] != 'P') continue;  // Tr:, etc. are not needed
     if (fields.size() != 13)
@@ -40,8 +40,8 @@ std::map<std::string, std::vector<double>> read_projections(const std::string& p
     for (std::size_t k = 1; k < fields.size(); ++k) {
       const auto v = parse_double(fields[k]);
       if (!v || !std::isfinite(*v))
-        throw input_error(clipped(path), line,
-                          name + ": '" + clipped(fields[k]) + "' is not a finite number");
+        throw input_error(clip_text(path), line,
+                          name + ": '" + clip_text(fields[k]) + "' is not a finite number");
       values.push_back(*v);
     }
     projections[name] = values;
@@ -76,7 +76,7 @@ fs::path ground_truth_path(const fs::path& dir) {
 
 KittiCalibration read_kitti_calibration(const std::string& calib_txt) {
   if (!regular_file_exists(calib_txt))
-    throw input_error(clipped(calib_txt), "calibration file does not exist");
+    throw input_error(clip_text(calib_txt), "calibration file does not exist");
   const auto projections = read_projections(calib_txt);
   const auto p0 = projections.find("P0");
   if (p0 == projections.end()) throw input_error(calib_txt, "no P0 line");

@@ -22,7 +22,7 @@ constexpr double kMaxBudgetFactor = 10.0;
 
 class Checker {
  public:
-  explicit Checker(const std::string& path) : path_(path.empty() ? std::string("settings") : clipped(path)) {}
+  explicit Checker(const std::string& path) : path_(path.empty() ? std::string("settings") : clip_text(path)) {}
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
     throw input_error(path_, key + ": " + reason);
@@ -183,8 +183,8 @@ void check_image_size(const Settings& settings, cv::Size image, const std::strin
   const auto& cam = settings.camera;
   if (cam.width <= 0 || cam.height <= 0) return;
   if (image.width == cam.width && image.height == cam.height) return;
-  const std::string file = settings.path.empty() ? std::string("settings") : clipped(settings.path);
-  throw input_error(clipped(image_path), "image is " + size_text(image.width, image.height) +
+  const std::string file = settings.path.empty() ? std::string("settings") : clip_text(settings.path);
+  throw input_error(clip_text(image_path), "image is " + size_text(image.width, image.height) +
                                              ", but the settings " + file + " give Camera.width/height " +
                                              size_text(cam.width, cam.height) +
                                              " (settings for another camera?)");

@@ -84,17 +84,17 @@ SettingsReader::SettingsReader(std::string path) : path_(std::move(path)) {
   std::error_code ec;
   const auto status = std::filesystem::status(path_, ec);
   if (status.type() == std::filesystem::file_type::not_found)
-    throw input_error(clipped(path_), "settings file does not exist");
-  if (ec) throw input_error(clipped(path_), "cannot access settings file: " + ec.message());
+    throw input_error(clip_text(path_), "settings file does not exist");
+  if (ec) throw input_error(clip_text(path_), "cannot access settings file: " + ec.message());
   if (!std::filesystem::is_regular_file(status))
-    throw input_error(clipped(path_), "settings path is not a regular file");
+    throw input_error(clip_text(path_), "settings path is not a regular file");
   try {
     storage_.open(path_, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
-    throw input_error(clipped(path_),
+    throw input_error(clip_text(path_),
                       std::string("cannot parse settings (YAML starting with %YAML:1.0 expected): ") + e.err);
   }
-  if (!storage_.isOpened()) throw input_error(clipped(path_), "cannot open settings file");
+  if (!storage_.isOpened()) throw input_error(clip_text(path_), "cannot open settings file");
   scan_keys();
 }
 
@@ -105,17 +105,17 @@ void SettingsReader::scan_keys() {
     for (auto it = root.begin(); it != root.end(); ++it) parsed.insert((*it).name());
   std::map<std::string, int> first_line;
   std::size_t unknown = 0;
-  const std::string file = clipped(path_);
+  const std::string file = clip_text(path_);
   for (const KeyLine& k : top_level_keys(read_lines(path_))) {
     if (parsed.count(k.key) == 0) continue;  // not a key after all
     if (const auto [it, inserted] = first_line.emplace(k.key, k.line); !inserted)
       throw input_error(file, k.line,
-                        clipped(k.key) + ": set twice (first on line " + std::to_string(it->second) + ")");
+                        clip_text(k.key) + ": set twice (first on line " + std::to_string(it->second) + ")");
     raw_values_[k.key] = k.value;
     if (is_accepted_settings_key(k.key)) continue;
     if (++unknown > kMaxUnknownKeyWarnings) continue;
     const std::string suggestion = suggestion_for(k.key);
-    warnings_.push_back(file + ":" + std::to_string(k.line) + ": " + clipped(k.key) +
+    warnings_.push_back(file + ":" + std::to_string(k.line) + ": " + clip_text(k.key) +
                         ": unknown key, ignored" +
                         (suggestion.empty() ? std::string() : " (did you mean " + suggestion + "?)"));
   }
@@ -125,7 +125,7 @@ void SettingsReader::scan_keys() {
     first_line.emplace(key, 0);
     if (++unknown > kMaxUnknownKeyWarnings) continue;
     const std::string suggestion = suggestion_for(key);
-    warnings_.push_back(file + ": " + clipped(key) + ": unknown key, ignored" +
+    warnings_.push_back(file + ": " + clip_text(key) + ": unknown key, ignored" +
                         (suggestion.empty() ? std::string() : " (did you mean " + suggestion + "?)"));
   }
   if (unknown > kMaxUnknownKeyWarnings)
@@ -135,7 +135,7 @@ void SettingsReader::scan_keys() {
 }
 
 void SettingsReader::fail(const std::string& key, const std::string& reason) const {
-  throw input_error(clipped(path_), key + ": " + reason);
+  throw input_error(clip_text(path_), key + ": " + reason);
 }
 
 cv::FileNode SettingsReader::node(const std::string& key) const {
@@ -172,7 +172,7 @@ std::optional<int> SettingsReader::integer(const std::string& key) const {
   if (std::floor(*value) != *value) fail(key, "expected an integer");
   if (*value < INT_MIN || *value > INT_MAX) {
     const auto raw = raw_values_.find(key);
-    const std::string written = raw != raw_values_.end() ? clipped(raw->second) : std::to_string(*value);
+    const std::string written = raw != raw_values_.end() ? clip_text(raw->second) : std::to_string(*value);
     fail(key, written + " is out of range for an integer (" + std::to_string(INT_MIN) + ".." +
                   std::to_string(INT_MAX) + ")");
   }

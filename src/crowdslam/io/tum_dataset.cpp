@@ -69,7 +69,7 @@ std::unique_ptr<Dataset> open_tum_dataset(const std::string& directory, const Da
     if (pairs.empty()) {
       char window[32];
       std::snprintf(window, sizeof(window), "%g", options.max_time_difference_s);
-      throw input_error(clipped(rgb_list), "no colour image has a depth map in " + clipped(depth_list) +
+      throw input_error(clip_text(rgb_list), "no colour image has a depth map in " + clip_text(depth_list) +
                                                " within " + window + " s (colour stamps " +
                                                span_of(colour_kept) + ", depth stamps " +
                                                span_of(depth_kept) + "); nothing to run on");

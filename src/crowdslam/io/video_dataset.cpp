@@ -12,7 +12,7 @@ std::unique_ptr<VideoSource> VideoSource::open_file(const std::string& path, con
   options.check();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw input_error(clipped(path), "video file does not exist");
+    throw input_error(clip_text(path), "video file does not exist");
   std::unique_ptr<VideoSource> source(new VideoSource(path, false));
   try {
     // FFmpeg handles nearly every file; OpenCV's own MJPEG reader and image-sequence patterns

@@ -18,10 +18,10 @@ double number(const std::string& path, int line, const std::vector<std::string>&
   const auto value = parse_double(fields[i]);
   if (!value)
     throw input_error(
-        path, line, "field " + std::to_string(i + 1) + " is not a number: '" + io::clipped(fields[i]) + "'");
+        path, line, "field " + std::to_string(i + 1) + " is not a number: '" + clip_text(fields[i]) + "'");
   if (finite && !std::isfinite(*value))
     throw input_error(path, line,
-                      "field " + std::to_string(i + 1) + " is not finite: '" + io::clipped(fields[i]) + "'");
+                      "field " + std::to_string(i + 1) + " is not finite: '" + clip_text(fields[i]) + "'");
   return *value;
 }
 
@@ -35,11 +35,11 @@ MotRow parse_row(const std::string& path, int line, const std::vector<std::strin
   row.line = line;
   const double frame = number(path, line, f, 0, true);
   if (frame < 1 || frame != std::floor(frame) || frame > 1e9)
-    throw input_error(path, line, "frame must be an integer >= 1, got '" + io::clipped(f[0]) + "'");
+    throw input_error(path, line, "frame must be an integer >= 1, got '" + clip_text(f[0]) + "'");
   row.frame = static_cast<int>(frame);
   const double id = number(path, line, f, 1, true);
   if (id != std::floor(id) || std::abs(id) > 2e9)
-    throw input_error(path, line, "id must be an integer, got '" + io::clipped(f[1]) + "'");
+    throw input_error(path, line, "id must be an integer, got '" + clip_text(f[1]) + "'");
   row.id = static_cast<int>(id);
   row.box = cv::Rect2f(
       static_cast<float>(number(path, line, f, 2, true)), static_cast<float>(number(path, line, f, 3, true)),
@@ -51,11 +51,11 @@ MotRow parse_row(const std::string& path, int line, const std::vector<std::strin
     if (cls != std::floor(cls) || cls < -1)
       throw input_error(
           path, line,
-          "9-column ground truth: class (field 8) must be an integer, got '" + io::clipped(f[7]) + "'");
+          "9-column ground truth: class (field 8) must be an integer, got '" + clip_text(f[7]) + "'");
     if (vis < 0 || vis > 1)
       throw input_error(
           path, line,
-          "9-column ground truth: visibility (field 9) must be in [0, 1], got '" + io::clipped(f[8]) + "'");
+          "9-column ground truth: visibility (field 9) must be in [0, 1], got '" + clip_text(f[8]) + "'");
     row.object_class = static_cast<int>(cls);
     row.visibility = vis;
   }
@@ -97,7 +97,7 @@ MotFile read_mot_file(const std::string& path, bool ground_truth) {
     spdlog::warn(
         "{}:{}: {} box{} skipped: {} with zero or negative width/height, {} with a coordinate or size beyond "
         "1e6 pixels",
-        io::clipped(path), file.first_dropped_line, file.dropped_empty + file.dropped_out_of_range,
+        clip_text(path), file.first_dropped_line, file.dropped_empty + file.dropped_out_of_range,
         file.dropped_empty + file.dropped_out_of_range == 1 ? "" : "es", file.dropped_empty,
         file.dropped_out_of_range);
   return file;

@@ -42,10 +42,10 @@ std::vector<std::string> sorted_images(const std::string& directory) {
     std::error_code entry_ec;
     const fs::file_status status = fs::status(it->path(), entry_ec);
     if (entry_ec && status.type() != fs::file_type::not_found)
-      throw input_error(io::clipped(it->path().string()), "cannot read image entry: " + entry_ec.message());
+      throw input_error(clip_text(it->path().string()), "cannot read image entry: " + entry_ec.message());
     if (fs::is_regular_file(status)) files.push_back(it->path().string());
   }
-  if (ec) throw input_error(io::clipped(directory), "cannot list directory: " + ec.message());
+  if (ec) throw input_error(clip_text(directory), "cannot list directory: " + ec.message());
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -79,10 +79,10 @@ std::unique_ptr<io::Dataset> open_mot_sequence(const std::string& directory) {
       std::snprintf(name, sizeof(name), "%06zu", i);
       const std::string file = (fs::path(im_dir) / (name + ext)).string();
       if (!fs::is_regular_file(file, ec))
-        throw input_error(io::clipped(file),
+        throw input_error(clip_text(file),
                           (ec && ec != std::errc::no_such_file_or_directory ? ec.message() + ": " : "") +
-                              "missing image (" + io::clipped(ini) +
-                              " says seqLength=" + io::clipped(info["seqLength"]) + ")");
+                              "missing image (" + clip_text(ini) +
+                              " says seqLength=" + clip_text(info["seqLength"]) + ")");
       files.push_back(file);
     }
   } else {

@@ -68,14 +68,14 @@ std::string trim(std::string_view text) {
 
 std::string clip_text(std::string_view text, size_t max_chars) {
   std::string result;
-  if (text.size() <= max_chars || max_chars < 16) {
-    result.assign(text.substr(0, std::max<size_t>(max_chars, 16)));
+  if (text.size() <= max_chars) {
+    result.assign(text);
   } else {
-    const size_t tail = (max_chars - 5) / 2;
-    const size_t head = max_chars - 5 - tail;
-    result.assign(text.substr(0, head));
-    result += " ... ";
-    result.append(text.substr(text.size() - tail));
+    const std::string suffix = " (" + std::to_string(text.size()) + " chars)";
+    const size_t room = max_chars > suffix.size() + 3 + 2 ? max_chars - suffix.size() - 3 : 2;
+    const size_t tail = room / 3;
+    const size_t head = room - tail;
+    result = std::string(text.substr(0, head)) + "..." + std::string(text.substr(text.size() - tail)) + suffix;
   }
   for (char& c : result) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';

@@ -19,8 +19,9 @@ std::vector<std::string> read_lines(const std::string& path);
 
 std::string trim(std::string_view text);
 
-// `text` cut to at most `max_chars` characters for a message: the start and the end are kept with
-// " ... " between them (paths keep their file name). Control characters become '?'.
+// User text quoted in a message: `text` itself when it has at most `max_chars` characters; otherwise its
+// start and its end (where a path keeps its file name) joined by "...", `max_chars` characters in all,
+// and the full length, e.g. "/very/long/dir...rgb/1.png (2097152 chars)". Control characters become '?'.
 std::string clip_text(std::string_view text, size_t max_chars = 300);
 
 }  // namespace crowdslam
