@@ -5,6 +5,12 @@
 // not met yet, see docs/RESULTS.md).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
 #include "crowdslam/run/run_sequence.h"
 #include "test_support.h"
 
@@ -33,4 +39,58 @@ TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
   EXPECT_LT(*summary.ate_rmse_m, 0.35);
   std::printf("[ measured ] kitti07_head sequential: %zu/%zu tracked, ATE %.3f m, %d keyframes\n", summary.tracked,
               summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>());
+}
+
+namespace {
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Runs the dataset twice in sequential mode and returns both runs' camera and keyframe trajectories.
+std::array<std::string, 4> two_sequential_runs(run::RunOptions options, const test::TempDir& tmp) {
+  std::array<std::string, 4> files;
+  for (int k = 0; k < 2; ++k) {
+    options.out_dir = (tmp / ("out" + std::to_string(k))).string();
+    const auto summary = run::run_sequence(options);
+    EXPECT_GT(summary.tracked, 0u);
+    files[2 * k] = read_file(std::filesystem::path(options.out_dir) / "CameraTrajectory.txt");
+    files[2 * k + 1] = read_file(std::filesystem::path(options.out_dir) / "KeyFrameTrajectory.txt");
+  }
+  return files;
+}
+}  // namespace
+
+// Issue 11: --sequential stays reproducible, byte for byte, on real data: monocular (two-view
+// initialisation, RANSAC) and RGB-D with the people detector.
+TEST(RunKitti, SequentialRunsGiveByteIdenticalTrajectories) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  run::RunOptions options;
+  options.dataset = test::shared_data("kitti07_head").string();
+  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
+  options.sensor = io::SensorKind::kMonocular;
+  options.sequential = true;
+  options.progress = false;
+  options.people_filter = false;
+  options.max_frames = 40;
+  const auto files = two_sequential_runs(options, tmp);
+  EXPECT_GT(files[0].size(), 1000u);
+  EXPECT_TRUE(files[0] == files[2]) << "camera trajectories differ between two sequential runs";
+  EXPECT_TRUE(files[1] == files[3]) << "keyframe trajectories differ between two sequential runs";
+}
+
+TEST(RunKitti, SequentialRgbdRunsWithThePeopleFilterGiveByteIdenticalTrajectories) {
+  CROWDSLAM_REQUIRE_SHARED("bonn_crowd");
+  test::TempDir tmp;
+  run::RunOptions options;
+  options.dataset = test::shared_data("bonn_crowd").string();
+  options.settings_path = (test::source_dir() / "config" / "Bonn.yaml").string();
+  options.sequential = true;
+  options.progress = false;
+  options.max_frames = 80;
+  const auto files = two_sequential_runs(options, tmp);
+  EXPECT_GT(files[0].size(), 1000u);
+  EXPECT_TRUE(files[0] == files[2]) << "camera trajectories differ between two sequential runs";
+  EXPECT_TRUE(files[1] == files[3]) << "keyframe trajectories differ between two sequential runs";
 }
