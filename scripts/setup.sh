@@ -11,7 +11,7 @@ shift || true
 packages=(
   build-essential cmake ninja-build pkg-config git ca-certificates curl time python3
   libopencv-dev libeigen3-dev libceres-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libjpeg62-turbo-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev
   opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
 )
 

@@ -84,6 +84,12 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                 "Skip (count and warn about) frames that cannot be read instead of failing the run");
   cmd->add_flag("--allow-untracked", args->options.allow_untracked,
                 "Exit 0 even when no frame could be tracked");
+  cmd->add_option("--save-map", args->options.save_map,
+                  "Write the final map to this SQLite file (atomically; also for an interrupted run)");
+  cmd->add_option("--load-map", args->options.load_map,
+                  "Start in this saved map: relocalise into it, then extend it (or only track with --localization)");
+  cmd->add_flag("--localization", args->options.localization,
+                "With --load-map: localisation only, no keyframe or map point is created or removed");
   cmd->callback([args, &global] {
     if (!args->sensor.empty()) args->options.sensor = io::parse_sensor_kind(args->sensor, "--sensor");
     args->options.max_frames = args->frames;

@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
   add_run_command(app, global);
   add_detect_command(app, global);
   add_vocab_command(app, global);
+  add_map_command(app, global);
 
   try {
     app.parse(argc, argv);

@@ -25,6 +25,13 @@ class SE3 {
       : SE3(Mat3(matrix.topLeftCorner<3, 3>()), Vec3(matrix.topRightCorner<3, 1>())) {}
 
   static SE3 identity() { return SE3(); }
+  // A rotation that is already a unit quaternion, kept bit for bit (saved maps reload exactly).
+  static SE3 from_unit_quaternion(const Eigen::Quaterniond& rotation, const Vec3& translation) {
+    SE3 pose;
+    pose.rotation_ = rotation;
+    pose.translation_ = translation;
+    return pose;
+  }
   // Exponential map of a twist (rho, phi): translation part first, rotation part second.
   static SE3 exp(const Vec6& twist);
   // Inverse of exp.

@@ -219,6 +219,15 @@ void KeyFrame::change_parent(const std::shared_ptr<KeyFrame>& parent) {
   parent->add_child(shared_from_this());
 }
 
+void KeyFrame::restore_parent(const std::shared_ptr<KeyFrame>& parent) {
+  {
+    std::lock_guard lock(connections_mutex_);
+    first_connection_ = false;
+    parent_ = parent;
+  }
+  if (parent) parent->add_child(shared_from_this());
+}
+
 void KeyFrame::add_loop_edge(const std::shared_ptr<KeyFrame>& other) {
   std::lock_guard lock(connections_mutex_);
   not_erase_ = true;

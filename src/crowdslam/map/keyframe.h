@@ -65,6 +65,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void erase_child(uint64_t child_id);
   void change_parent(const std::shared_ptr<KeyFrame>& parent);
   void add_loop_edge(const std::shared_ptr<KeyFrame>& other);
+  // Saved maps: sets the spanning-tree parent as stored (null for a root) and marks the keyframe as
+  // already attached, so a later update_connections() keeps the stored tree.
+  void restore_parent(const std::shared_ptr<KeyFrame>& parent);
   [[nodiscard]] std::vector<std::shared_ptr<KeyFrame>> loop_edges() const;
 
   // Lifetime. set_bad() unlinks the keyframe from its points and neighbours, repairs the spanning tree

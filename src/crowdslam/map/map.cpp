@@ -113,4 +113,15 @@ void Map::clear() {
   for (auto& [id, kf] : keyframes) kf->release_links();
 }
 
+std::pair<uint64_t, uint64_t> Map::id_counters() const {
+  std::lock_guard lock(mutex_);
+  return {next_keyframe_id_, next_map_point_id_};
+}
+
+void Map::restore_id_counters(uint64_t next_keyframe_id, uint64_t next_map_point_id) {
+  std::lock_guard lock(mutex_);
+  next_keyframe_id_ = next_keyframe_id;
+  next_map_point_id_ = next_map_point_id;
+}
+
 }  // namespace crowdslam::map

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace crowdslam::map {
@@ -39,6 +40,9 @@ class Map {
 
   uint64_t next_keyframe_id();
   uint64_t next_map_point_id();
+  // Saved maps: the id counters (the next ids to hand out), and setting them on load.
+  [[nodiscard]] std::pair<uint64_t, uint64_t> id_counters() const;
+  void restore_id_counters(uint64_t next_keyframe_id, uint64_t next_map_point_id);
 
   // Incremented on every big change (loop closure, global BA) so tracking can notice.
   void notify_big_change();

@@ -268,4 +268,31 @@ std::shared_ptr<MapPoint> MapPoint::replaced_by() const {
   return replaced_by_.lock();
 }
 
+MapPoint::SavedState MapPoint::saved_state() const {
+  SavedState state;
+  {
+    std::lock_guard lock(position_mutex_);
+    state.normal = normal_;
+    state.min_distance = min_distance_;
+    state.max_distance = max_distance_;
+  }
+  std::lock_guard lock(features_mutex_);
+  state.visible = visible_;
+  state.found = found_;
+  return state;
+}
+
+void MapPoint::restore(const SavedState& state, const Descriptor& descriptor) {
+  {
+    std::lock_guard lock(position_mutex_);
+    normal_ = state.normal;
+    min_distance_ = state.min_distance;
+    max_distance_ = state.max_distance;
+  }
+  std::lock_guard lock(features_mutex_);
+  visible_ = state.visible;
+  found_ = state.found;
+  descriptor_ = descriptor;
+}
+
 }  // namespace crowdslam::map

@@ -63,6 +63,17 @@ class MapPoint {
   [[nodiscard]] int visible_count() const;
   [[nodiscard]] int found_count() const;
 
+  // Saved maps (mapdb/): the viewing geometry and statistics as stored, and their restoration on load.
+  struct SavedState {
+    geometry::Vec3 normal = geometry::Vec3::Zero();
+    float min_distance = 0;  // as kept internally (min_distance() returns 0.8 x this)
+    float max_distance = 0;  // (max_distance() returns 1.2 x this)
+    int visible = 1;
+    int found = 1;
+  };
+  [[nodiscard]] SavedState saved_state() const;
+  void restore(const SavedState& state, const Descriptor& descriptor);
+
   // Lifetime. set_bad() erases the point from every keyframe that observes it (the map removes it
   // separately, see Map::erase_map_point). replace() moves all observations to `other`.
   [[nodiscard]] bool is_bad() const;

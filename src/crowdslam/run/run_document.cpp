@@ -226,6 +226,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   for (const auto& segment : summary.segments) segments.push_back(segment_json(segment));
   doc["segments"] = segments;
   doc["input"] = c.input;
+  doc["map"] = c.map;
   const auto mapper = slam.mapper_stats();
   const int processed = std::max(1, mapper.keyframes_processed);
   doc["local_mapping"] = {{"keyframes_processed", mapper.keyframes_processed},

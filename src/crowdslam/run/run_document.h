@@ -40,6 +40,7 @@ struct RunContext {
   double wall_s;
   const std::vector<double>& load_ms;
   nlohmann::json input;  // input warnings and skipped frames
+  nlohmann::json map;    // loaded / saved map (run/map_files.h), null without either
 };
 nlohmann::json final_document(const RunContext& context, const std::vector<system::FrameReport>& reports,
                               const RunSummary& summary, const nlohmann::json& accuracy);

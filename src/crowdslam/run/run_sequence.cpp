@@ -13,6 +13,7 @@
 #include "crowdslam/journal/run_journal.h"
 #include "crowdslam/run/frame_prefetcher.h"
 #include "crowdslam/run/input_checks.h"
+#include "crowdslam/run/map_files.h"
 #include "crowdslam/run/sensor_pacer.h"
 #include "crowdslam/run/run_document.h"
 #include "crowdslam/system/system.h"
@@ -107,8 +108,10 @@ void write_final_outputs(const std::filesystem::path& out, const system::System&
 
 RunSummary run_sequence(const RunOptions& options) {
   journal::check_output_dir(options.out_dir, options.overwrite);  // before anything is read
+  check_map_options(options);
   Prepared p = prepare(options);
   system::System slam(p.run_settings, system_options(options, p.sensor));
+  nlohmann::json map_json = load_map_if_requested(options, slam);  // a bad map fails before any output
 
   // From here on the run has outputs: the directory, run.json saying "running", the journal.
   const std::filesystem::path out(options.out_dir);
@@ -198,6 +201,17 @@ RunSummary run_sequence(const RunOptions& options) {
   if (end.kind == system::EndState::Kind::kInterrupted) {
     spdlog::warn("run interrupted by {} after {} frames; writing the outputs", signal_name(end.signal), reports.size());
   }
+  add_localization_stats(reports, map_json);
+  try {
+    save_map_if_requested(options, slam, end.to_string(), map_json);
+  } catch (const std::exception& e) {
+    if (map_json.is_object()) map_json["save_error"] = e.what();
+    if (end.kind != system::EndState::Kind::kFailed) {
+      end.kind = system::EndState::Kind::kFailed;
+      end.reason = e.what();
+      error = std::current_exception();
+    }
+  }
 
   RunSummary summary;
   summary.out_dir = options.out_dir;
@@ -238,7 +252,7 @@ RunSummary run_sequence(const RunOptions& options) {
   input["skipped_frames"] = skipped.count;
   input["first_skipped_error"] = skipped.first_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(skipped.first_error);
   if (skipped.count > 1) spdlog::warn("{} unreadable frames skipped (first: {})", skipped.count, skipped.first_error);
-  const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam, wall_s, load_ms, input};
+  const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam, wall_s, load_ms, input, map_json};
   summary.json = final_document(context, reports, summary, accuracy);
   write_final_outputs(out, slam, format, summary.json);
 

@@ -54,6 +54,12 @@ struct RunOptions {
   // whose successor has already arrived when tracking gets to it is dropped and counted, as a camera
   // driver drops frames nobody took. Default: every frame, as fast as the system goes.
   bool pace_sensor = false;
+  // Saved maps (docs/MAPS.md): --load-map FILE.db before the first frame (relocalised into it), with
+  // --localization tracking only (no keyframe or point created or removed); --save-map FILE.db at the
+  // end, whatever the end state (an interrupted run's map is a valid map).
+  std::string load_map;
+  bool localization = false;
+  std::string save_map;
 };
 
 // Accuracy of one trajectory (a map segment) against the ground truth.

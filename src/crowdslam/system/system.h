@@ -11,6 +11,7 @@
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/loop/keyframe_database.h"
 #include "crowdslam/loop/loop_closer.h"
+#include "crowdslam/mapdb/map_database.h"
 #include "crowdslam/mapping/local_mapper.h"
 #include "crowdslam/people/detection_worker.h"
 #include "crowdslam/people/feature_budget.h"
@@ -101,6 +102,16 @@ class System {
   // Stops the threads (shutdown() when the run completed, stop_now() otherwise) and tells the observers.
   void finish(const EndState& end);
 
+  // Saved maps (system_map.cpp, mapdb/map_database.h). The identity a map must have to be loaded here;
+  // loading one before the first frame (throws InputError for a bad file or a map that does not fit;
+  // with `localization_only` tracking never creates keyframes); saving the current map (call after
+  // finish(): no thread may write the map meanwhile). A loaded map's origin is kept when it is saved.
+  [[nodiscard]] mapdb::MapIdentity map_identity() const;
+  mapdb::LoadedMap load_map(const std::string& path, bool localization_only);
+  void save_map(const std::string& path, const mapdb::MapOrigin& origin) const;
+  [[nodiscard]] bool map_loaded() const { return loaded_map_origin_.has_value(); }
+  [[nodiscard]] bool localization_only() const { return tracker_->localization_only(); }
+
   // Observers (not owned; see run_observer.h). Add before the first frame.
   void add_observer(RunObserver* observer) { observers_.push_back(observer); }
 
@@ -174,6 +185,7 @@ class System {
   int next_feature_budget_ = 0;
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;
+  std::optional<mapdb::MapOrigin> loaded_map_origin_;
   bool shut_down_ = false;
 };
 

@@ -56,6 +56,13 @@ void Tracker::reset() {
   monocular_initializer_.reset();
 }
 
+void Tracker::start_in_loaded_map(bool localization_only) {
+  reset();
+  state_ = TrackingState::kLost;
+  map_loaded_ = true;
+  localization_only_ = localization_only;
+}
+
 TrackResult Tracker::track(map::Frame frame) {
   TrackResult result;
   result.keypoints = static_cast<int>(frame.size());
@@ -98,7 +105,7 @@ TrackResult Tracker::track(map::Frame frame) {
         if (p && p->num_observations() < 1) p.reset();
       }
       temporal_points_.clear();
-      KeyframeDecision decision = need_new_keyframe(frame);
+      KeyframeDecision decision = localization_only_ ? KeyframeDecision::kNo : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
         // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
         // mapper can write its bundle adjustment back) rather than track on without new points.
@@ -118,7 +125,7 @@ TrackResult Tracker::track(map::Frame frame) {
       frame.discard_outliers();
     } else {
       velocity_.reset();
-      if (map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
+      if (!map_loaded_ && map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
         result.map_reset = true;
       }

@@ -76,6 +76,12 @@ class Tracker {
   // tracking and relocalisation. Without it only frames built with a bag of words use one.
   void set_vocabulary(std::shared_ptr<const bow::Vocabulary> vocabulary) { vocabulary_ = std::move(vocabulary); }
 
+  // A map was loaded into the (so far empty) map: the next frame relocalises against it instead of
+  // initialising, and the loaded map is never reset. With `localization_only` no keyframe is created
+  // (so local mapping gets nothing and no point or keyframe is added or removed).
+  void start_in_loaded_map(bool localization_only);
+  [[nodiscard]] bool localization_only() const { return localization_only_; }
+
   [[nodiscard]] TrackingState state() const { return state_; }
   [[nodiscard]] const map::Frame* last_frame() const { return last_frame_ ? &*last_frame_ : nullptr; }
   void reset();
@@ -115,6 +121,8 @@ class Tracker {
   uint64_t last_keyframe_frame_id_ = 0;
   uint64_t last_relocalization_frame_id_ = 0;
   int inliers_in_local_map_ = 0;
+  bool map_loaded_ = false;
+  bool localization_only_ = false;
   std::vector<std::shared_ptr<map::MapPoint>> temporal_points_;  // visual-odometry points of the last frame
   std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
   std::vector<std::shared_ptr<map::MapPoint>> local_points_;

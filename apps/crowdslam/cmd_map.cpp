@@ -1,0 +1,100 @@
+// `crowdslam map info|export`: look into a saved map and export it for other tools.
+#include <iostream>
+
+#include "commands.h"
+#include "crowdslam/mapdb/map_database.h"
+#include "crowdslam/mapdb/map_export.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::app {
+
+namespace {
+nlohmann::json info_json(const std::string& file, const mapdb::MapInfo& info) {
+  const auto& id = info.header.identity;
+  const auto& o = info.header.origin;
+  return {{"file", file},
+          {"file_bytes", info.file_bytes},
+          {"schema_version", info.header.schema_version},
+          {"sensor", id.sensor},
+          {"camera",
+           {{"fx", id.camera.fx}, {"fy", id.camera.fy}, {"cx", id.camera.cx}, {"cy", id.camera.cy},
+            {"width", id.camera.width}, {"height", id.camera.height}, {"bf", id.camera.bf}}},
+          {"depth_map_factor", id.depth_map_factor},
+          {"orb", {{"features", id.orb_features}, {"scale_factor", id.orb_scale_factor}, {"levels", id.orb_levels}}},
+          {"vocabulary", {{"hash", id.vocabulary_hash}, {"words", id.vocabulary_words}}},
+          {"origin",
+           {{"dataset", o.dataset}, {"created_utc", o.created_utc}, {"crowdslam_version", o.crowdslam_version},
+            {"end_state", o.end_state}}},
+          {"keyframes", info.keyframes},
+          {"map_points", info.map_points},
+          {"observations", info.observations},
+          {"covisibility_edges", info.covisibility_edges},
+          {"loop_edges", info.loop_edges},
+          {"bounds",
+           {{"min", {info.points_min[0], info.points_min[1], info.points_min[2]}},
+            {"max", {info.points_max[0], info.points_max[1], info.points_max[2]}}}}};
+}
+}  // namespace
+
+void add_map_command(CLI::App& app, const GlobalOptions& global) {
+  auto* map_cmd = app.add_subcommand("map", "Inspect and export saved maps (run --save-map FILE.db)");
+  map_cmd->require_subcommand(1);
+
+  auto file = std::make_shared<std::string>();
+  auto* info = map_cmd->add_subcommand("info", "Keyframes, points, observations, loops, bounds, sensor, vocabulary");
+  info->add_option("file", *file, "Map database")->required();
+  info->callback([file, &global] {
+    const auto map_info = mapdb::read_map_info(*file);
+    const auto doc = info_json(*file, map_info);
+    if (global.json) {
+      print_json(doc);
+      return;
+    }
+    const auto& b = doc["bounds"];
+    std::cout << "map               " << *file << " (" << map_info.file_bytes / 1024 << " KiB, schema "
+              << map_info.header.schema_version << ")\n"
+              << "sensor            " << map_info.header.identity.sensor << ", camera "
+              << map_info.header.identity.camera.width << "x" << map_info.header.identity.camera.height << " fx "
+              << map_info.header.identity.camera.fx << "\n"
+              << "vocabulary        " << map_info.header.identity.vocabulary_hash << " ("
+              << map_info.header.identity.vocabulary_words << " words)\n"
+              << "origin            " << map_info.header.origin.dataset << ", " << map_info.header.origin.created_utc
+              << ", crowdslam " << map_info.header.origin.crowdslam_version << ", run "
+              << map_info.header.origin.end_state << "\n"
+              << "keyframes         " << map_info.keyframes << "\n"
+              << "map points        " << map_info.map_points << " (" << map_info.observations << " observations)\n"
+              << "covisibility      " << map_info.covisibility_edges << " edges\n"
+              << "loop edges        " << map_info.loop_edges << "\n"
+              << "bounds            " << b["min"].dump() << " to " << b["max"].dump() << "\n";
+  });
+
+  struct ExportArgs {
+    std::string file, ply, keyframes, trajectory;
+  };
+  auto args = std::make_shared<ExportArgs>();
+  auto* exp = map_cmd->add_subcommand("export", "Points as binary PLY, keyframes as PLY, keyframe trajectory (TUM)");
+  exp->add_option("file", args->file, "Map database")->required();
+  exp->add_option("--ply", args->ply, "Map points (x y z float, observations uint) as binary PLY");
+  exp->add_option("--keyframes", args->keyframes, "Keyframe positions as binary PLY");
+  exp->add_option("--trajectory", args->trajectory, "Keyframe trajectory, TUM format");
+  exp->callback([args, &global] {
+    if (args->ply.empty() && args->keyframes.empty() && args->trajectory.empty()) {
+      throw InputError("map export: give at least one of --ply, --keyframes, --trajectory");
+    }
+    nlohmann::json doc = {{"file", args->file}};
+    if (!args->ply.empty()) doc["points"] = mapdb::export_points_ply(args->file, args->ply);
+    if (!args->keyframes.empty()) doc["keyframes"] = mapdb::export_keyframes_ply(args->file, args->keyframes);
+    if (!args->trajectory.empty()) doc["trajectory_poses"] = mapdb::export_keyframe_trajectory(args->file, args->trajectory);
+    if (global.json) {
+      print_json(doc);
+    } else {
+      if (doc.contains("points")) std::cout << "points            " << doc["points"] << " -> " << args->ply << "\n";
+      if (doc.contains("keyframes")) std::cout << "keyframes         " << doc["keyframes"] << " -> " << args->keyframes << "\n";
+      if (doc.contains("trajectory_poses")) {
+        std::cout << "trajectory        " << doc["trajectory_poses"] << " poses -> " << args->trajectory << "\n";
+      }
+    }
+  });
+}
+
+}  // namespace crowdslam::app
