@@ -49,7 +49,7 @@ std::string vocabulary_hash(const bow::Vocabulary& vocabulary) {
     h.add(vocabulary.word_node(word));
     h.add(vocabulary.word_weight(word));
   }
-  char buffer[24];
+  char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "fnv1a64:%016llx", static_cast<unsigned long long>(h.value()));
   return buffer;
 }
