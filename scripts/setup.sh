@@ -13,6 +13,7 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libjpeg62-turbo-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev
   opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
+  libjs-chart.js chromium   # report.html inlines Chart.js; the report tests open it in headless Chromium
 )
 
 missing=()

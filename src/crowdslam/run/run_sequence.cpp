@@ -11,6 +11,7 @@
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/journal/output_dir.h"
 #include "crowdslam/journal/run_journal.h"
+#include "crowdslam/report/run_report.h"
 #include "crowdslam/run/frame_prefetcher.h"
 #include "crowdslam/run/input_checks.h"
 #include "crowdslam/run/map_files.h"
@@ -255,6 +256,7 @@ RunSummary run_sequence(const RunOptions& options) {
   const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam, wall_s, load_ms, input, map_json};
   summary.json = final_document(context, reports, summary, accuracy);
   write_final_outputs(out, slam, format, summary.json);
+  report::write_run_report(out, summary.json);  // never fails the run: logged, recorded in run.json
 
   if (error) {
     const std::string where = " (the " + std::to_string(summary.tracked) + " frames tracked before it are in " +
