@@ -15,7 +15,7 @@
 namespace crowdslam::test {
 
 // A synthetic RGB-D room with `people` walking people and their ground-truth boxes (people_gt.txt).
-inline std::filesystem::path make_crowd_room(const TempDir& tmp, int people, int frames = 60) {
+inline std::filesystem::path make_crowd_room(const TempDir& tmp, int people, int frames = 40) {
   synth::SynthOptions options;
   options.frames = frames;
   options.trajectory = synth::TrajectoryKind::kSweep;  // passes people (7 % of the image at most)

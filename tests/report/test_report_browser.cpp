@@ -3,8 +3,10 @@
 // (scripts/setup.sh installs it).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "crowdslam/report/report.h"
 #include "report_test_helpers.h"
@@ -57,8 +59,10 @@ TEST(ReportBrowser, PageDrawsEveryChartWithoutErrorsOffline) {
   EXPECT_EQ(test::body_attribute(dom, "data-charts"), std::to_string(kChartsWithGroundTruth));
   EXPECT_EQ(test::body_attribute(dom, "data-charts-expected"), std::to_string(kChartsWithGroundTruth));
   EXPECT_NE(dom.find("<td>completed</td>"), std::string::npos);                 // summary table filled in
-  EXPECT_NE(dom.find("<figcaption>frame 50</figcaption>"), std::string::npos);  // the saved-frame strip
+  EXPECT_NE(dom.find("<figcaption>frame 30</figcaption>"), std::string::npos);  // the saved-frame strip
 
+  // Screenshots of the page, and of the same page with a Chart.js that draws nothing: the charts must
+  // make a large visible difference (blank canvases would not).
   const auto png = tmp / "report.png";
   ASSERT_EQ(
       test::run_chromium(
@@ -71,8 +75,31 @@ TEST(ReportBrowser, PageDrawsEveryChartWithoutErrorsOffline) {
   cv::Scalar mean, stddev;
   cv::meanStdDev(image, mean, stddev);
   EXPECT_GT(stddev[0], 15.0) << "a near-blank screenshot";
-  // The run's colour: its swatch in the table is 100 pixels; the rest are drawn trajectories and series.
-  EXPECT_GT(pixels_near(image, kFirstRunColour, 30), 3000);
+
+  const auto stub = tmp / "stub_chart.js";
+  test::write_text(stub,
+                   "window.Chart = function () {};\n"
+                   "window.Chart.defaults = { font: {}, plugins: { legend: { labels: {} } } };\n");
+  report::ReportOptions no_charts;
+  no_charts.chartjs = stub;
+  const auto blank_html = tmp / "blank.html";
+  report::write_report(tmp / "out", {}, blank_html, no_charts);
+  const auto blank_png = tmp / "blank.png";
+  ASSERT_EQ(
+      test::run_chromium(
+          tmp.path(), "--hide-scrollbars --window-size=1280,2400 --screenshot='" + blank_png.string() + "'",
+          blank_html),
+      0);
+  const cv::Mat blank = cv::imread(blank_png.string(), cv::IMREAD_COLOR);
+  ASSERT_EQ(blank.size(), image.size());
+  cv::Mat difference, changed;
+  cv::absdiff(image, blank, difference);
+  cv::cvtColor(difference, difference, cv::COLOR_BGR2GRAY);
+  cv::threshold(difference, changed, 40, 255, cv::THRESH_BINARY);
+  const int changed_pixels = cv::countNonZero(changed);
+  EXPECT_GT(changed_pixels, 50000) << "the charts drew (almost) nothing";
+  std::printf("[ measured ] screenshot stddev %.1f, %d pixels drawn by the charts\n", stddev[0],
+              changed_pixels);
 }
 
 TEST(ReportBrowser, CompareOverlaysTwoRuns) {

@@ -91,7 +91,7 @@ TEST_F(ReportRun, FrameSeriesAndPageDataFollowRunJson) {
   const auto run = report::load_run(out_);
   const auto& frames = run.document["frames"];
   ASSERT_EQ(run.frames.size(), frames.size());
-  ASSERT_EQ(run.frames.size(), 60u);
+  ASSERT_EQ(run.frames.size(), 40u);
   int removed = 0;
   for (size_t i = 0; i < frames.size(); ++i) {
     EXPECT_EQ(run.frames.keypoints[i], frames[i]["keypoints"].get<double>());
@@ -99,13 +99,13 @@ TEST_F(ReportRun, FrameSeriesAndPageDataFollowRunJson) {
     removed += frames[i]["keypoints_before_filter"].get<int>() - frames[i]["keypoints"].get<int>();
   }
   EXPECT_GT(removed, 0);                   // the filter removed keypoints on people
-  EXPECT_EQ(run.saved_frames.size(), 6u);  // --save-frames 10 over 60 frames
+  EXPECT_EQ(run.saved_frames.size(), 4u);  // --save-frames 10 over 40 frames
   const auto page = report::page_data({run}, {});
   ASSERT_EQ(page["runs"].size(), 1u);
   const auto& r = page["runs"][0];
-  EXPECT_EQ(r["frames"]["t"].size(), 60u);
+  EXPECT_EQ(r["frames"]["t"].size(), 40u);
   EXPECT_DOUBLE_EQ(r["frames"]["t"][0].get<double>(), 0.0);
-  EXPECT_EQ(r["saved_frames"].size(), 6u);
+  EXPECT_EQ(r["saved_frames"].size(), 4u);
   EXPECT_EQ(r["saved_frames"][0]["src"].get<std::string>().rfind("data:image/jpeg;base64,", 0), 0u);
   EXPECT_EQ(r["summary"].size(), report::summary_rows().size());
   EXPECT_EQ(r["segments"][0]["errors"]["e"].size(), run.segments[0].ate->matches.size());
@@ -118,10 +118,28 @@ TEST_F(ReportRun, WriteReportRegeneratesAndCompares) {
   const auto result = report::write_report(out_, {other}, html);
   EXPECT_EQ(result.runs, 2u);
   EXPECT_EQ(result.bytes, fs::file_size(html));
-  EXPECT_EQ(result.frames_embedded, 2u * 6u);  // 24 frames per report, shared: 12 per run, 6 saved each
+  EXPECT_EQ(result.frames_embedded, 2u * 4u);  // 24 frames per report, shared: 12 per run, 4 saved each
   const std::string page = test::read_text(html);
   EXPECT_NE(page.find("\"label\":\"copy\""), std::string::npos);
   EXPECT_NE(page.find("\"label\":\"out\""), std::string::npos);
+}
+
+TEST_F(ReportRun, KittiTrajectoryGetsTheTrackedFramesStamps) {
+  // Output.trajectory_format: kitti writes no stamps: they come from run.json's tracked frames.
+  const auto dir = copy_run("kitti_format");
+  for (const char* name : {"CameraTrajectory.txt", "KeyFrameTrajectory.txt"}) {
+    const auto poses = io::read_tum_trajectory((out_ / name).string());
+    io::write_kitti_trajectory((dir / name).string(), poses);
+  }
+  ASSERT_EQ(io::detect_trajectory_format((dir / "CameraTrajectory.txt").string()), io::TrajectoryFormat::kKitti);
+  const auto tum = report::load_run(out_);
+  const auto kitti = report::load_run(dir);
+  ASSERT_TRUE(kitti.evaluated_segment.has_value());
+  const auto& a = tum.segments[0];
+  const auto& b = kitti.segments[0];
+  ASSERT_EQ(a.estimate.size(), b.estimate.size());
+  for (size_t i = 0; i < a.estimate.size(); ++i) ASSERT_EQ(a.estimate[i].timestamp_s, b.estimate[i].timestamp_s);
+  EXPECT_NEAR(b.ate->translation_error_m.rmse, tum.document["accuracy"]["ate_rmse_m"].get<double>(), 1e-8);
 }
 
 TEST_F(ReportRun, MissingOrBrokenRunJsonNamesFileAndKey) {
@@ -186,6 +204,31 @@ TEST_F(ReportRun, MovedDatasetGivesAReportWithoutGroundTruth) {
   EXPECT_FALSE(run.evaluated_segment.has_value());
   // Shown as tracked, in the run's own frame.
   EXPECT_EQ(run.segments[0].aligned.size(), summary_->tracked);
+}
+
+TEST(Report, RunWhoseReportFailsKeepsItsOutputsAndExitCode) {
+  test::TempDir tmp;
+  const auto dataset = test::make_crowd_room(tmp, 0, 20);
+  const char* previous = std::getenv("CROWDSLAM_CHARTJS");
+  const std::string saved = previous ? previous : "";
+  setenv("CROWDSLAM_CHARTJS", (tmp / "missing.js").c_str(), 1);
+  run::RunSummary summary;
+  const auto message = test::error_of([&] { summary = test::run_room(dataset, tmp / "out", false); });
+  if (previous) {
+    setenv("CROWDSLAM_CHARTJS", saved.c_str(), 1);
+  } else {
+    unsetenv("CROWDSLAM_CHARTJS");
+  }
+  EXPECT_EQ(message, "");  // the run did not fail
+  EXPECT_EQ(summary.end.to_string(), "completed");
+  EXPECT_EQ(summary.tracked, 20u);
+  EXPECT_FALSE(fs::exists(tmp / "out" / "report.html"));
+  EXPECT_EQ(io::read_tum_trajectory((tmp / "out" / "CameraTrajectory.txt").string()).size(), 20u);
+  const auto doc = read_json(tmp / "out" / "run.json");
+  ASSERT_TRUE(doc.contains("report_error"));
+  EXPECT_NE(doc["report_error"].get<std::string>().find("libjs-chart.js"), std::string::npos);
+  EXPECT_EQ(doc["end_state"], "completed");
+  EXPECT_EQ(doc["summary"]["tracked_frames"], 20);
 }
 
 TEST(Report, MonocularAlignmentIsSim3) {

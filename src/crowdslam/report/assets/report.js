@@ -9,6 +9,10 @@
   var axisNames = ['x', 'y', 'z'];
   var main = document.getElementById('report');
   var drawn = 0;
+  var lastTime = 0;  // of any run's last frame: the time axes end there
+  runs.forEach(function (run) {
+    if (run.frames.t.length > 0) lastTime = Math.max(lastTime, run.frames.t[run.frames.t.length - 1]);
+  });
   var expected = 0;
 
   Chart.defaults.animation = false;
@@ -17,6 +21,10 @@
   Chart.defaults.plugins.legend.labels.boxWidth = 12;
 
   function colour(k) { return palette[k % palette.length]; }
+  // Series j of run k: with one run each series has its own colour; with several, the run's colour
+  // (series then differ by line style).
+  var seriesPalette = ['#1f77b4', '#ff7f0e', '#2ca02c', '#9467bd'];
+  function seriesColour(k, j) { return runs.length === 1 ? seriesPalette[j % seriesPalette.length] : colour(k); }
 
   function faded(hex, opacity) {
     var v = parseInt(hex.slice(1), 16);
@@ -76,6 +84,9 @@
     };
   }
 
+  function timeAxis() {
+    return axis('time (s)', { min: 0, max: Math.max(lastTime, 0.001), ticks: { includeBounds: false } });
+  }
   function title(text) { return { display: true, text: text }; }
   function axis(text, extra) {
     var a = { type: 'linear', title: { display: true, text: text } };
@@ -159,7 +170,10 @@
 
   function drawTrajectories() {
     var aligned = runs.filter(function (run) { return run.alignment !== 'none'; }).map(function (run) {
-      return run.label + ': ' + run.alignment;
+      var evaluated = run.evaluated_segment !== null ? run.segments[run.evaluated_segment] : null;
+      var scale = run.alignment === 'sim3' && evaluated && evaluated.errors
+          ? ', scale ' + evaluated.errors.scale.toPrecision(4) : '';
+      return run.label + ': ' + run.alignment + scale;
     });
     var note = aligned.length > 0
         ? 'Estimated trajectory aligned to the ground truth as the ATE is (' + aligned.join(', ') + '; each map segment on its own).'
@@ -187,7 +201,7 @@
     var node = section('Translation error over time', 'errors',
                        'Distance between each aligned pose and its ground-truth pose (the ATE is the RMS of these).');
     addChart(node, '', { type: 'line', data: { datasets: datasets },
-                         options: { scales: { x: axis('time (s)'), y: axis('translation error (m)', { beginAtZero: true }) },
+                         options: { scales: { x: timeAxis(), y: axis('translation error (m)', { beginAtZero: true }) },
                                     plugins: { legend: legend() } } });
   }
 
@@ -198,16 +212,17 @@
     var datasets = [];
     runs.forEach(function (run, k) {
       var f = run.frames;
-      var stages = [['extraction', f.extraction_ms, 0.75], ['detector wait', f.detector_wait_ms, 0.45],
-                    ['tracking', f.tracking_ms, 0.2]];
+      var single = runs.length === 1;
+      var stages = [['extraction', f.extraction_ms, single ? 0.6 : 0.75], ['detector wait', f.detector_wait_ms, single ? 0.6 : 0.45],
+                    ['tracking', f.tracking_ms, single ? 0.6 : 0.2]];
       stages.forEach(function (stage, j) {
         datasets.push(line(run.label + ': ' + stage[0], points(f.t, stage[1]), k,
                            { stack: run.label, fill: j === 0 ? 'origin' : '-1', borderWidth: 0.6,
-                             backgroundColor: faded(colour(k), stage[2]) }));
+                             borderColor: seriesColour(k, j), backgroundColor: faded(seriesColour(k, j), stage[2]) }));
       });
     });
     addChart(node, 'tall', { type: 'line', data: { datasets: datasets },
-                             options: { scales: { x: axis('time (s)'), y: axis('ms', { stacked: true, beginAtZero: true }) } } });
+                             options: { scales: { x: timeAxis(), y: axis('ms', { stacked: true, beginAtZero: true }) } } });
   }
 
   function drawMapping() {
@@ -234,12 +249,14 @@
     var datasets = [];
     runs.forEach(function (run, k) {
       var f = run.frames;
-      datasets.push(line(run.label + ': people coverage', points(f.t, f.people_area, 100), k, { yAxisID: 'y' }));
+      datasets.push(line(run.label + ': people coverage', points(f.t, f.people_area, 100), k,
+                         { yAxisID: 'y', borderColor: seriesColour(k, 0), backgroundColor: seriesColour(k, 0) }));
       datasets.push(line(run.label + ': person boxes', points(f.t, f.person_boxes), k,
-                         { yAxisID: 'boxes', borderDash: [4, 3], borderWidth: 1 }));
+                         { yAxisID: 'boxes', borderDash: [4, 3], borderWidth: 1, borderColor: seriesColour(k, 1),
+                           backgroundColor: seriesColour(k, 1) }));
     });
     addChart(node, '', { type: 'line', data: { datasets: datasets },
-                         options: { scales: { x: axis('time (s)'), y: axis('covered by people (%)', { beginAtZero: true }),
+                         options: { scales: { x: timeAxis(), y: axis('covered by people (%)', { beginAtZero: true }),
                                               boxes: axis('person boxes', { position: 'right', beginAtZero: true,
                                                                             grid: { drawOnChartArea: false } }) } } });
   }
@@ -251,13 +268,19 @@
     runs.forEach(function (run, k) {
       var f = run.frames;
       var removed = f.keypoints_before_filter.map(function (before, i) { return before - f.keypoints[i]; });
-      datasets.push(line(run.label + ': feature budget', points(f.t, f.feature_budget), k, { borderWidth: 2 }));
-      datasets.push(line(run.label + ': keypoints kept', points(f.t, f.keypoints), k, { borderWidth: 1, borderDash: [5, 2] }));
-      datasets.push(line(run.label + ': keypoints removed', points(f.t, removed), k,
-                         { borderWidth: 1, borderColor: faded(colour(k), 0.55), backgroundColor: faded(colour(k), 0.55) }));
+      var style = function (j, extra) {
+        var c = runs.length === 1 ? seriesColour(k, j) : faded(colour(k), [1, 1, 0.55][j]);
+        var d = { borderColor: c, backgroundColor: c };
+        Object.keys(extra).forEach(function (key) { d[key] = extra[key]; });
+        return d;
+      };
+      datasets.push(line(run.label + ': feature budget', points(f.t, f.feature_budget), k, style(0, { borderWidth: 2 })));
+      datasets.push(line(run.label + ': keypoints kept', points(f.t, f.keypoints), k,
+                         style(1, { borderWidth: 1, borderDash: runs.length === 1 ? [] : [5, 2] })));
+      datasets.push(line(run.label + ': keypoints removed', points(f.t, removed), k, style(2, { borderWidth: 1 })));
     });
     addChart(node, '', { type: 'line', data: { datasets: datasets },
-                         options: { scales: { x: axis('time (s)'), y: axis('keypoints', { beginAtZero: true }) } } });
+                         options: { scales: { x: timeAxis(), y: axis('keypoints', { beginAtZero: true }) } } });
   }
 
   // ---- tracking timeline -----------------------------------------------------------------------
@@ -295,7 +318,7 @@
     });
     addChart(node, 'tall', {
       type: 'scatter', data: { datasets: datasets },
-      options: { scales: { x: axis('time (s)'),
+      options: { scales: { x: timeAxis(),
                            y: { type: 'linear', min: -0.5, max: rows.length - 0.5,
                                 afterBuildTicks: function (scale) {
                                   scale.ticks = rows.map(function (row, i) { return { value: i }; });
