@@ -8,7 +8,7 @@
 # Every run uses the default threaded mode (tracking + detection worker + local mapping + loop closing +
 # frame prefetcher + journal writer), on every sensor: RGB-D (synthetic, bonn_crowd), monocular
 # (bonn_crowd --sensor mono, kitti07_head), stereo (euroc_v101_micro, right-image thread), and a run
-# interrupted by SIGINT mid-way (the fast-stop path). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are
+# interrupted by SIGINT mid-way (the fast-stop path), and saved maps (save, localise, continue, export). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are
 # also grepped for reports as a second check).
 # Environment: CROWDSLAM_JOBS (default 2), CROWDSLAM_SANITIZE_OUT (default out/sanitize),
 #   CROWDSLAM_SANITIZE_BUILD_TYPE (default RelWithDebInfo), CROWDSLAM_SHARED (default ../shared),
@@ -173,9 +173,19 @@ run_sanitizer() {
   run_step "$tag run synth two laps (loop closing)" "$out/run_loop.log" \
     "$bin" run --dataset "$out/loop_sequence" --out "$out/run_loop" --overwrite --no-people-filter || true
   if [[ -f "$bonn/rgb.txt" ]]; then
-    run_step "$tag run bonn_crowd ($bonn_frames frames, depth filter)" "$out/run_bonn.log" \
+    run_step "$tag run bonn_crowd ($bonn_frames frames, depth filter, --save-map)" "$out/run_bonn.log" \
       "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --filter-mode depth \
-      --out "$out/run_bonn" || true
+      --out "$out/run_bonn" --save-map "$out/bonn.db" || true
+    # Saved maps: localisation in the map just saved, and continue mapping from it.
+    run_step "$tag run bonn_crowd --load-map --localization" "$out/run_bonn_loc.log" \
+      "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --filter-mode depth \
+      --out "$out/run_bonn_loc" --load-map "$out/bonn.db" --localization || true
+    run_step "$tag run bonn_crowd --load-map (continue mapping)" "$out/run_bonn_continue.log" \
+      "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --filter-mode depth \
+      --out "$out/run_bonn_continue" --load-map "$out/bonn.db" --save-map "$out/bonn2.db" || true
+    run_step "$tag map info/export" "$out/map_export.log" \
+      "$bin" map export "$out/bonn2.db" --ply "$out/bonn2.ply" --keyframes "$out/bonn2_kf.ply" \
+      --trajectory "$out/bonn2_kf.txt" || true
     # Monocular on the same frames (two-view initialisation, monocular keyframe policy).
     run_step "$tag run bonn_crowd mono ($bonn_frames frames)" "$out/run_bonn_mono.log" \
       "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --sensor mono \

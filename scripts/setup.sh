@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev
   opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
   libjs-chart.js chromium   # report.html inlines Chart.js; the report tests open it in headless Chromium
+  libjs-three libcpp-httplib-dev   # the live viewer: three.js served by our own HTTP server
 )
 
 missing=()

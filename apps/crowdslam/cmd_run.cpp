@@ -88,6 +88,12 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "Write the final map to this SQLite file (atomically; also for an interrupted run)");
   cmd->add_option("--load-map", args->options.load_map,
                   "Start in this saved map: relocalise into it, then extend it (or only track with --localization)");
+  cmd->add_flag("--viewer", args->options.viewer,
+                "Live web viewer during the run (map, keyframes, camera, image with people, status, pause/step)");
+  cmd->add_option("--viewer-host", args->options.viewer_host,
+                  "Address the viewer listens on (default 127.0.0.1; the viewer has no authentication)");
+  cmd->add_option("--viewer-port", args->options.viewer_port, "Viewer port (default 8080; 0: any free port)")
+      ->check(CLI::Range(0, 65535));
   cmd->add_flag("--localization", args->options.localization,
                 "With --load-map: localisation only, no keyframe or map point is created or removed");
   cmd->callback([args, &global] {

@@ -24,6 +24,7 @@ void add_run_command(CLI::App& app, GlobalOptions& global);
 void add_detect_command(CLI::App& app, const GlobalOptions& global);
 void add_vocab_command(CLI::App& app, const GlobalOptions& global);
 void add_map_command(CLI::App& app, const GlobalOptions& global);
+void add_view_command(CLI::App& app, const GlobalOptions& global);
 void add_report_command(CLI::App& app, const GlobalOptions& global);
 
 // Prints a JSON document (pretty, newline-terminated) to stdout.

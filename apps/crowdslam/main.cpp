@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
   add_detect_command(app, global);
   add_vocab_command(app, global);
   add_map_command(app, global);
+  add_view_command(app, global);
   add_report_command(app, global);
 
   try {

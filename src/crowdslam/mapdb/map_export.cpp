@@ -87,3 +87,39 @@ size_t export_keyframe_trajectory(const std::filesystem::path& map_file, const s
 }
 
 }  // namespace crowdslam::mapdb
+
+namespace crowdslam::mapdb {
+
+MapContents read_map_contents(const std::filesystem::path& map_file, int min_weight) {
+  Database db = open_map(map_file);
+  MapContents contents;
+  {
+    auto st = db.prepare(
+        "SELECT p.id, p.x, p.y, p.z, (SELECT COUNT(*) FROM observations o WHERE o.point_id = p.id) FROM map_points p "
+        "ORDER BY p.id");
+    while (st.step()) {
+      contents.points.push_back({static_cast<uint64_t>(st.integer(0)), st.real(1), st.real(2), st.real(3),
+                                 static_cast<int>(st.integer(4))});
+    }
+  }
+  {
+    auto st = db.prepare("SELECT id, timestamp, qx, qy, qz, qw, tx, ty, tz FROM keyframes ORDER BY id");
+    while (st.step()) {
+      const Eigen::Quaterniond q(st.real(5), st.real(2), st.real(3), st.real(4));
+      const geometry::SE3 cam_from_world(q, geometry::Vec3(st.real(6), st.real(7), st.real(8)));
+      contents.keyframes.push_back({static_cast<uint64_t>(st.integer(0)), st.real(1), cam_from_world.inverse()});
+    }
+  }
+  {
+    auto st = db.prepare("SELECT keyframe_id, other_id FROM covisibility WHERE keyframe_id < other_id AND weight >= ?");
+    st.bind(1, static_cast<int64_t>(min_weight));
+    while (st.step()) contents.covisibility.emplace_back(st.integer(0), st.integer(1));
+  }
+  {
+    auto st = db.prepare("SELECT keyframe_id, other_id FROM loop_edges WHERE keyframe_id < other_id");
+    while (st.step()) contents.loop_edges.emplace_back(st.integer(0), st.integer(1));
+  }
+  return contents;
+}
+
+}  // namespace crowdslam::mapdb

@@ -12,3 +12,33 @@ size_t export_keyframes_ply(const std::filesystem::path& map_file, const std::fi
 size_t export_keyframe_trajectory(const std::filesystem::path& map_file, const std::filesystem::path& tum);
 
 }  // namespace crowdslam::mapdb
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "crowdslam/geometry/se3.h"
+
+namespace crowdslam::mapdb {
+
+// The map's geometry only (for viewers): point positions with observation counts, keyframe poses,
+// covisibility edges with at least `min_weight` shared points, loop edges (each edge once).
+struct MapContents {
+  struct Point {
+    uint64_t id = 0;
+    double x = 0, y = 0, z = 0;
+    int observations = 0;
+  };
+  struct Keyframe {
+    uint64_t id = 0;
+    double timestamp_s = 0;
+    geometry::SE3 world_from_cam;
+  };
+  std::vector<Point> points;
+  std::vector<Keyframe> keyframes;
+  std::vector<std::pair<uint64_t, uint64_t>> covisibility;
+  std::vector<std::pair<uint64_t, uint64_t>> loop_edges;
+};
+MapContents read_map_contents(const std::filesystem::path& map_file, int min_weight = 100);
+
+}  // namespace crowdslam::mapdb

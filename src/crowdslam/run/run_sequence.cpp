@@ -16,6 +16,7 @@
 #include "crowdslam/run/input_checks.h"
 #include "crowdslam/run/map_files.h"
 #include "crowdslam/run/sensor_pacer.h"
+#include "crowdslam/run/viewer_session.h"
 #include "crowdslam/run/run_document.h"
 #include "crowdslam/system/system.h"
 #include "crowdslam/util/atomic_file.h"
@@ -58,7 +59,7 @@ system::SystemOptions system_options(const RunOptions& options, io::SensorKind s
   s.people_filter = options.people_filter;
   s.detections_file = options.detections_file;
   s.detector_model = options.detector_model;
-  s.record_keypoints = options.save_frames > 0;
+  s.record_keypoints = options.save_frames > 0 || options.viewer;  // drawn by the journal / the viewer
   s.vocabulary_path = options.vocabulary;
   s.loop_closing = options.loop_closing;
   return s;
@@ -113,6 +114,15 @@ RunSummary run_sequence(const RunOptions& options) {
   Prepared p = prepare(options);
   system::System slam(p.run_settings, system_options(options, p.sensor));
   nlohmann::json map_json = load_map_if_requested(options, slam);  // a bad map fails before any output
+  std::unique_ptr<ViewerSession> viewer;  // a port in use fails before any output too
+  if (options.viewer) {
+    ViewerSessionOptions viewer_options;
+    viewer_options.host = options.viewer_host;
+    viewer_options.port = options.viewer_port;
+    viewer_options.ground_truth = p.source->ground_truth();
+    viewer_options.monocular = p.sensor == io::SensorKind::kMonocular;
+    viewer = std::make_unique<ViewerSession>(viewer_options);
+  }
 
   // From here on the run has outputs: the directory, run.json saying "running", the journal.
   const std::filesystem::path out(options.out_dir);
@@ -140,6 +150,7 @@ RunSummary run_sequence(const RunOptions& options) {
   }
   journal::RunJournal& journal = *journal_ptr;
   slam.add_observer(&journal);
+  if (viewer) slam.add_observer(&viewer->observer());
 
   InputMonitor monitor(p.run_settings, p.sensor);
   std::vector<system::FrameReport> reports;
@@ -158,6 +169,11 @@ RunSummary run_sequence(const RunOptions& options) {
         end.kind = system::EndState::Kind::kInterrupted;
         end.signal = signal;
         break;
+      }
+      if (viewer) {
+        viewer->wait_while_paused();
+        viewer->set_progress(reports.size(), false);
+        if (interrupt_signal()) continue;  // handled at the top of the loop
       }
       const auto load_start = Clock::now();
       auto frame = prefetcher.next();
@@ -201,6 +217,10 @@ RunSummary run_sequence(const RunOptions& options) {
   }
   if (end.kind == system::EndState::Kind::kInterrupted) {
     spdlog::warn("run interrupted by {} after {} frames; writing the outputs", signal_name(end.signal), reports.size());
+  }
+  if (viewer) {
+    viewer->set_progress(reports.size(), true);
+    viewer->stop();
   }
   add_localization_stats(reports, map_json);
   try {

@@ -60,6 +60,11 @@ struct RunOptions {
   std::string load_map;
   bool localization = false;
   std::string save_map;
+  // --viewer: a live web viewer during the run (docs/VIEWER.md), on viewer_host:viewer_port (0: any
+  // free port; the URL is printed).
+  bool viewer = false;
+  std::string viewer_host = "127.0.0.1";
+  int viewer_port = 8080;
 };
 
 // Accuracy of one trajectory (a map segment) against the ground truth.

@@ -9,8 +9,11 @@
 // System they are added to (or be removed first).
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "crowdslam/geometry/se3.h"
 #include "crowdslam/io/dataset.h"
@@ -42,6 +45,28 @@ struct EndState {
   [[nodiscard]] bool completed() const { return kind == Kind::kCompleted; }
 };
 
+// A cheap, consistent copy of the map for observers (taken under the map-update lock on the tracking
+// thread, so no observer touches live map objects): point positions, keyframe poses and graph edges.
+struct MapSnapshot {
+  struct Point {
+    uint64_t id = 0;
+    float x = 0, y = 0, z = 0;
+    int observations = 0;
+  };
+  struct Keyframe {
+    uint64_t id = 0;
+    double timestamp_s = 0;
+    geometry::SE3 world_from_cam;
+  };
+  size_t frame_index = 0;  // taken after this frame
+  int map_id = 0;          // segment (changes when the map is reset)
+  std::vector<Point> points;
+  std::vector<Keyframe> keyframes;
+  std::vector<std::pair<uint64_t, uint64_t>> covisibility;  // strong edges (weight >= 100), each once
+  std::vector<std::pair<uint64_t, uint64_t>> loop_edges;    // each once
+  int loops_closed = 0;
+};
+
 class RunObserver {
  public:
   virtual ~RunObserver() = default;
@@ -53,6 +78,11 @@ class RunObserver {
   virtual void on_keyframe(uint64_t /*id*/) {}
   // The map was reset: `segment` is the map that ended.
   virtual void on_reset(const MapSegment& /*segment*/) {}
+  // How often this observer wants a MapSnapshot, in seconds of wall time (0: never, the default). System
+  // takes one snapshot for all observers that want one when the shortest interval has passed, after a
+  // frame, and a last one in finish().
+  [[nodiscard]] virtual double map_snapshot_interval_s() const { return 0; }
+  virtual void on_map_snapshot(const std::shared_ptr<const MapSnapshot>& /*snapshot*/) {}
   // The run is over (System::finish): the threads are stopped and the final trajectories are available.
   virtual void on_finish(const EndState& /*end*/) {}
 };

@@ -278,6 +278,7 @@ void System::finish(const EndState& end) {
   } else {
     stop_now();
   }
+  publish_map_snapshot(true);
   for (auto* observer : observers_) observer->on_finish(end);
 }
 
@@ -417,6 +418,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     for (auto* observer : observers_) observer->on_keyframe(result.reference_keyframe->id);
   }
   if (result.map_reset) reset_map();
+  publish_map_snapshot(false);
   return report;
 }
 

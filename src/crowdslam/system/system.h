@@ -1,6 +1,7 @@
 #pragma once
 // Wires the SLAM threads together: frame building (ORB) and tracking on the caller's thread, local mapping
 // in its own thread (or inline in sequential mode). The only place that knows all parts.
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -150,6 +151,9 @@ class System {
     bool tracked = false;
   };
   void reset_map();
+  // Takes a MapSnapshot for the observers that want one when their interval has passed (or `force`).
+  void publish_map_snapshot(bool force);
+  [[nodiscard]] std::shared_ptr<const MapSnapshot> take_map_snapshot() const;
   // The record's pose through its reference keyframe (or the stored one).
   [[nodiscard]] geometry::SE3 world_from_cam(const TrajectoryRecord& record) const;
   [[nodiscard]] io::Trajectory live_keyframe_trajectory() const;
@@ -186,6 +190,7 @@ class System {
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;
   std::optional<mapdb::MapOrigin> loaded_map_origin_;
+  std::optional<std::chrono::steady_clock::time_point> last_snapshot_;
   bool shut_down_ = false;
 };
 

@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "crowdslam/map/keyframe.h"
+#include "crowdslam/map/map_point.h"
 #include "crowdslam/system/system.h"
 #include "crowdslam/util/error.h"
 
@@ -45,6 +46,55 @@ void System::save_map(const std::string& path, const mapdb::MapOrigin& origin) c
   header.identity = map_identity();
   header.origin = loaded_map_origin_ ? *loaded_map_origin_ : origin;
   mapdb::save_map(path, *map_, header);
+}
+
+}  // namespace crowdslam::system
+
+namespace crowdslam::system {
+
+void System::publish_map_snapshot(bool force) {
+  double interval = 0;
+  for (auto* observer : observers_) {
+    const double wanted = observer->map_snapshot_interval_s();
+    if (wanted > 0 && (interval == 0 || wanted < interval)) interval = wanted;
+  }
+  if (interval == 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (!force && last_snapshot_ && std::chrono::duration<double>(now - *last_snapshot_).count() < interval) return;
+  last_snapshot_ = now;
+  const auto snapshot = take_map_snapshot();
+  for (auto* observer : observers_) {
+    if (observer->map_snapshot_interval_s() > 0) observer->on_map_snapshot(snapshot);
+  }
+}
+
+std::shared_ptr<const MapSnapshot> System::take_map_snapshot() const {
+  auto snapshot = std::make_shared<MapSnapshot>();
+  snapshot->frame_index = next_frame_id_ > 0 ? next_frame_id_ - 1 : 0;
+  snapshot->map_id = map_resets_;
+  std::lock_guard lock(map_->update_mutex());  // no half-applied bundle adjustment
+  const auto keyframes = map_->keyframes();
+  snapshot->keyframes.reserve(keyframes.size());
+  for (const auto& kf : keyframes) {
+    if (kf->is_bad()) continue;
+    snapshot->keyframes.push_back({kf->id, kf->timestamp_s, kf->world_from_cam()});
+    for (const auto& other : kf->covisible_by_weight(100)) {
+      if (other->id > kf->id) snapshot->covisibility.emplace_back(kf->id, other->id);
+    }
+    for (const auto& other : kf->loop_edges()) {
+      if (other->id > kf->id) snapshot->loop_edges.emplace_back(kf->id, other->id);
+    }
+  }
+  const auto points = map_->map_points();
+  snapshot->points.reserve(points.size());
+  for (const auto& point : points) {
+    if (point->is_bad()) continue;
+    const auto w = point->world();
+    snapshot->points.push_back({point->id, static_cast<float>(w.x()), static_cast<float>(w.y()),
+                                static_cast<float>(w.z()), point->num_observations()});
+  }
+  snapshot->loops_closed = loop_closer_ ? static_cast<int>(loop_closer_->stats().loops.size()) : 0;
+  return snapshot;
 }
 
 }  // namespace crowdslam::system

@@ -1,0 +1,63 @@
+#pragma once
+// The viewer's HTTP server (cpp-httplib) in its own thread: the page, three.js (served from Debian's
+// libjs-three, never a CDN), the Server-Sent Events stream, the run state and the pause/step/resume
+// controls. It serves a fixed list of paths and nothing from the file system, binds to 127.0.0.1 unless
+// told otherwise, and has no authentication (docs/VIEWER.md).
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "crowdslam/viewer/event_stream.h"
+#include "crowdslam/viewer/run_control.h"
+
+namespace httplib {
+class Server;
+}
+
+namespace crowdslam::viewer {
+
+struct ViewerServerOptions {
+  std::string host = "127.0.0.1";
+  int port = 8080;         // 0: any free port
+  std::string three_dir;   // "" = $CROWDSLAM_THREE_DIR or the Debian path (/usr/share/javascript/three)
+  void check() const;      // throws InputError naming the bad option
+};
+
+class ViewerServer {
+ public:
+  // `control` may be null (a finished result: no pause/step). `state_json` gives GET /state.
+  ViewerServer(ViewerServerOptions options, EventStream& stream, RunControl* control,
+               std::function<std::string()> state_json);
+  ~ViewerServer();
+  ViewerServer(const ViewerServer&) = delete;
+  ViewerServer& operator=(const ViewerServer&) = delete;
+
+  // Reads the assets and binds the port (InputError when three.js is missing or the port is taken), then
+  // serves on its own thread.
+  void start();
+  // Closes the event stream (clients see its end) and stops the server. Idempotent.
+  void stop();
+  [[nodiscard]] int port() const { return port_; }
+  [[nodiscard]] std::string url() const;
+  // The last status a page posted (POST /client: updates received, JavaScript errors, WebGL), "" if none.
+  [[nodiscard]] std::string client_report() const;
+
+ private:
+  ViewerServerOptions options_;
+  EventStream& stream_;
+  RunControl* control_;
+  std::function<std::string()> state_json_;
+  std::unique_ptr<httplib::Server> server_;
+  std::thread thread_;
+  int port_ = 0;
+  std::string three_js_, orbit_controls_js_;
+  mutable std::mutex client_mutex_;
+  std::string client_report_;
+};
+
+// The page (viewer/page.cpp).
+const std::string& viewer_page_html();
+
+}  // namespace crowdslam::viewer

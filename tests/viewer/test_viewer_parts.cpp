@@ -1,0 +1,184 @@
+// The live viewer's parts (issue 13): the event stream, the pause control, the HTTP server's routes,
+// refusals, a port in use and clients that go away.
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "crowdslam/util/error.h"
+#include "crowdslam/viewer/event_stream.h"
+#include "crowdslam/viewer/run_control.h"
+#include "crowdslam/viewer/viewer_server.h"
+
+using namespace crowdslam;
+using namespace std::chrono_literals;
+
+TEST(EventStream, NewClientGetsTheNewestOfEachEventThenEverythingLive) {
+  viewer::EventStream stream(4);
+  stream.publish("map", "{\"m\":1}");
+  stream.publish("frame", "{\"f\":1}");
+  stream.publish("map", "{\"m\":2}");
+  viewer::EventStream::Cursor cursor;
+  auto first = stream.wait(cursor, 10ms);
+  ASSERT_EQ(first.size(), 2u);  // frame 1, map 2 (in publishing order), not map 1
+  EXPECT_EQ(*first[0], "event: frame\ndata: {\"f\":1}\n\n");
+  EXPECT_EQ(*first[1], "event: map\ndata: {\"m\":2}\n\n");
+  EXPECT_TRUE(stream.wait(cursor, 10ms).empty());  // nothing new: times out
+  for (int i = 0; i < 6; ++i) stream.publish("frame", std::to_string(i));
+  const auto live = stream.wait(cursor, 10ms);
+  ASSERT_EQ(live.size(), 4u);  // bounded: only the newest 4 are kept
+  EXPECT_EQ(*live.back(), "event: frame\ndata: 5\n\n");
+}
+
+TEST(EventStream, CloseWakesAWaitingClientAtOnce) {
+  viewer::EventStream stream;
+  viewer::EventStream::Cursor cursor;
+  stream.wait(cursor, 1ms);
+  std::atomic<bool> returned{false};
+  std::thread client([&] {
+    stream.wait(cursor, 10s);
+    returned = true;
+  });
+  std::this_thread::sleep_for(50ms);
+  EXPECT_FALSE(returned);
+  const auto start = std::chrono::steady_clock::now();
+  stream.close();
+  client.join();
+  EXPECT_TRUE(returned);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 2s);
+  EXPECT_TRUE(stream.closed());
+  stream.publish("frame", "{}");  // ignored once closed
+  EXPECT_EQ(stream.published(), 0u);
+}
+
+TEST(RunControl, PauseBlocksTheRunUntilStepLetsExactlyOneFrameThrough) {
+  viewer::RunControl control;
+  control.wait_while_paused(nullptr);  // running: returns at once
+  control.pause();
+  std::atomic<int> frames{0};
+  std::atomic<bool> stop{false};
+  std::thread run([&] {
+    while (!stop) {
+      control.wait_while_paused([&] { return stop.load(); });
+      if (!stop) ++frames;
+    }
+  });
+  std::this_thread::sleep_for(150ms);
+  EXPECT_EQ(frames, 0);
+  control.step();
+  std::this_thread::sleep_for(250ms);
+  EXPECT_EQ(frames, 1);
+  control.resume();
+  std::this_thread::sleep_for(50ms);
+  EXPECT_GT(frames, 1);
+  control.pause();
+  stop = true;
+  run.join();
+  EXPECT_TRUE(control.paused());
+}
+
+namespace {
+viewer::ViewerServerOptions any_port() {
+  viewer::ViewerServerOptions options;
+  options.port = 0;
+  return options;
+}
+}  // namespace
+
+TEST(ViewerServer, ServesItsAssetsOnlyAndNoFileSystemPath) {
+  viewer::EventStream stream;
+  viewer::ViewerServer server(any_port(), stream, nullptr, [] { return std::string("{\"frames\":3}"); });
+  server.start();
+  httplib::Client client("127.0.0.1", server.port());
+  const auto page = client.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("crowdslam viewer"), std::string::npos);
+  EXPECT_NE(page->body.find("/three.min.js"), std::string::npos);
+  EXPECT_EQ(page->body.find("http://"), std::string::npos);  // nothing from the network
+  EXPECT_EQ(page->body.find("https://"), std::string::npos);
+  const auto three = client.Get("/three.min.js");
+  ASSERT_TRUE(three);
+  EXPECT_EQ(three->status, 200);
+  EXPECT_GT(three->body.size(), 100000u);
+  const auto controls = client.Get("/OrbitControls.js");
+  ASSERT_TRUE(controls);
+  EXPECT_NE(controls->body.find("OrbitControls"), std::string::npos);
+  for (const char* path : {"/../../../../etc/passwd", "/etc/passwd", "/usr/share/javascript/three/three.min.js",
+                           "/%2e%2e/%2e%2e/etc/passwd", "/three.min.js/../../etc/passwd", "/index.html~"}) {
+    const auto r = client.Get(path);
+    ASSERT_TRUE(r) << path;
+    EXPECT_EQ(r->status, 404) << path;
+  }
+  const auto state = client.Get("/state");
+  ASSERT_TRUE(state);
+  EXPECT_EQ(state->body, "{\"run\":{\"frames\":3},\"client\":null}");
+  const auto pause = client.Post("/control/pause", "", "text/plain");
+  ASSERT_TRUE(pause);
+  EXPECT_EQ(pause->status, 409);  // a finished result cannot be paused
+  const auto report = client.Post("/client", "{\"updates\":4}", "application/json");
+  ASSERT_TRUE(report);
+  EXPECT_EQ(server.client_report(), "{\"updates\":4}");
+  EXPECT_EQ(client.Post("/client", std::string(5000, 'x'), "application/json")->status, 400);
+}
+
+TEST(ViewerServer, APortInUseIsAClearErrorBeforeAnythingRuns) {
+  viewer::EventStream a, b;
+  viewer::ViewerServer first(any_port(), a, nullptr, nullptr);
+  first.start();
+  viewer::ViewerServerOptions same;
+  same.port = first.port();
+  viewer::ViewerServer second(same, b, nullptr, nullptr);
+  try {
+    second.start();
+    FAIL() << "a second server on port " << same.port << " must fail";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--viewer-port " + std::to_string(same.port)), std::string::npos) << e.what();
+  }
+  viewer::ViewerServerOptions bad;
+  bad.port = 70000;
+  EXPECT_THROW(viewer::ViewerServer(bad, b, nullptr, nullptr), InputError);
+}
+
+TEST(ViewerServer, AClientLeavingMidStreamDoesNotDisturbTheOthers) {
+  viewer::EventStream stream;
+  viewer::RunControl control;
+  viewer::ViewerServer server(any_port(), stream, &control, nullptr);
+  server.start();
+  std::atomic<bool> publishing{true};
+  std::thread producer([&] {
+    for (int i = 0; publishing; ++i) {
+      stream.publish("frame", "{\"index\":" + std::to_string(i) + "}");
+      std::this_thread::sleep_for(5ms);
+    }
+  });
+  // A client that reads a little of the stream and hangs up.
+  {
+    httplib::Client client("127.0.0.1", server.port());
+    size_t received = 0;
+    const auto r = client.Get("/events", [&](const char*, size_t n) {
+      received += n;
+      return received < 200;  // false: abort the download
+    });
+    EXPECT_GE(received, 200u);
+  }
+  // Others are still served, and the controls work.
+  httplib::Client other("127.0.0.1", server.port());
+  size_t received = 0;
+  other.Get("/events", [&](const char*, size_t n) {
+    received += n;
+    return received < 500;
+  });
+  EXPECT_GE(received, 500u);
+  const auto pause = other.Post("/control/pause", "", "text/plain");
+  ASSERT_TRUE(pause);
+  EXPECT_EQ(pause->body, "{\"paused\":true}");
+  EXPECT_TRUE(control.paused());
+  publishing = false;
+  producer.join();
+  const auto start = std::chrono::steady_clock::now();
+  server.stop();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
+}
