@@ -131,15 +131,41 @@ TEST_F(ReportRun, KittiTrajectoryGetsTheTrackedFramesStamps) {
     const auto poses = io::read_tum_trajectory((out_ / name).string());
     io::write_kitti_trajectory((dir / name).string(), poses);
   }
-  ASSERT_EQ(io::detect_trajectory_format((dir / "CameraTrajectory.txt").string()), io::TrajectoryFormat::kKitti);
+  ASSERT_EQ(io::detect_trajectory_format((dir / "CameraTrajectory.txt").string()),
+            io::TrajectoryFormat::kKitti);
   const auto tum = report::load_run(out_);
   const auto kitti = report::load_run(dir);
   ASSERT_TRUE(kitti.evaluated_segment.has_value());
   const auto& a = tum.segments[0];
   const auto& b = kitti.segments[0];
   ASSERT_EQ(a.estimate.size(), b.estimate.size());
-  for (size_t i = 0; i < a.estimate.size(); ++i) ASSERT_EQ(a.estimate[i].timestamp_s, b.estimate[i].timestamp_s);
+  for (size_t i = 0; i < a.estimate.size(); ++i)
+    ASSERT_EQ(a.estimate[i].timestamp_s, b.estimate[i].timestamp_s);
   EXPECT_NEAR(b.ate->translation_error_m.rmse, tum.document["accuracy"]["ate_rmse_m"].get<double>(), 1e-8);
+}
+
+TEST_F(ReportRun, ReportCommand) {
+  const auto html = tmp_->path() / "cli" / "both.html";
+  fs::create_directories(html.parent_path());
+  auto r =
+      test::run_cli({"--json", "report", out_.string(), "--compare", out_.string(), "--out", html.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc["runs"], 2);
+  EXPECT_EQ(doc["bytes"].get<size_t>(), fs::file_size(html));
+  EXPECT_NE(test::read_text(html).find("/out (2)\","), std::string::npos);  // the same run twice
+
+  const auto copy = copy_run("cli_default");
+  fs::remove(copy / "report.html");
+  r = test::run_cli({"report", copy.string()});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(copy / "report.html"));  // default: OUT/report.html
+
+  r = test::run_cli({"report", (tmp_->path() / "not_a_run").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("error: " + (tmp_->path() / "not_a_run" / "run.json").string() + ": not found"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST_F(ReportRun, MissingOrBrokenRunJsonNamesFileAndKey) {
