@@ -165,18 +165,32 @@ const std::string& viewer_page_html() {
  function onTrajectory(m, line) { setPositions(line.geometry, m.positions); }
 
  // Events.
- function count() { updates += 1; body.dataset.updates = String(updates); dirty = true; maybeClick(); }
- const source = new EventSource('/events');
- source.addEventListener('frame', e => { count(); onFrame(JSON.parse(e.data)); });
- source.addEventListener('map', e => { count(); onMap(JSON.parse(e.data)); });
- source.addEventListener('image', e => { count(); onImage(JSON.parse(e.data)); });
- source.addEventListener('ground_truth', e => { count(); onTrajectory(JSON.parse(e.data), groundTruthLine); });
- source.addEventListener('trajectory', e => {
-  count(); const m = JSON.parse(e.data); trajectory.length = 0; trajectory.push(...m.positions); onTrajectory(m, trajectoryLine);
- });
- source.addEventListener('reset', e => { count(); trajectory.length = 0; knownIds = new Set(); showStatus('map reset'); });
- source.addEventListener('finish', e => { count(); body.dataset.finished = 'yes'; showStatus('run ' + JSON.parse(e.data).end_state); });
- source.onerror = function () { showStatus('disconnected'); };
+ function count() {
+  updates += 1; body.dataset.updates = String(updates); dirty = true; maybeClick();
+  setTimeout(renderSoon, 0);  // after the handler has applied the update
+ }
+ // Rendering is driven by animation frames, and also (throttled) by updates: a page whose animation
+ // frames are suspended (hidden tab, headless screenshot) still shows the newest state.
+ let lastRender = 0;
+ function renderSoon() {
+  const now = performance.now();
+  if (now - lastRender < 100 || params.get('norender')) return;
+  lastRender = now; dirty = false; renderer.render(scene, camera); renders += 1; body.dataset.renders = String(renders);
+ }
+ function connect() {
+  const source = new EventSource('/events');
+  source.addEventListener('frame', e => { count(); onFrame(JSON.parse(e.data)); });
+  source.addEventListener('map', e => { count(); onMap(JSON.parse(e.data)); });
+  source.addEventListener('image', e => { count(); onImage(JSON.parse(e.data)); });
+  source.addEventListener('ground_truth', e => { count(); onTrajectory(JSON.parse(e.data), groundTruthLine); });
+  source.addEventListener('trajectory', e => {
+   count(); const m = JSON.parse(e.data); trajectory.length = 0; trajectory.push(...m.positions); onTrajectory(m, trajectoryLine);
+  });
+  source.addEventListener('reset', e => { count(); trajectory.length = 0; knownIds = new Set(); showStatus('map reset'); });
+  source.addEventListener('finish', e => { count(); body.dataset.finished = 'yes'; showStatus('run ' + JSON.parse(e.data).end_state); });
+  source.onerror = function () { showStatus('disconnected'); };
+ }
+ connect();
 
  // Controls.
  function control(action) { return fetch('/control/' + action, { method: 'POST' }).then(r => r.json()).then(s => { body.dataset.paused = String(s.paused); }).catch(() => {}); }
@@ -205,6 +219,8 @@ const std::string& viewer_page_html() {
   requestAnimationFrame(animate);
   if (!dirty) return;
   dirty = false;
+  if (params.get('norender')) return;
+  lastRender = performance.now();
   renderer.render(scene, camera);
   renders += 1; body.dataset.renders = String(renders);
  }
