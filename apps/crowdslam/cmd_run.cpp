@@ -47,7 +47,7 @@ void print_summary(const run::RunSummary& summary) {
     std::cout << "ATE alignment     sim3 (scale " << accuracy["sim3_scale"].get<double>() << ")\n";
   }
   if (summary.rpe_trans_rmse_m) std::cout << "RPE trans RMSE    " << *summary.rpe_trans_rmse_m << " m/s\n";
-  std::cout << "outputs           " << summary.out_dir << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json}\n";
+  std::cout << "outputs           " << summary.out_dir << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json,report.html}\n";
 }
 }  // namespace
 

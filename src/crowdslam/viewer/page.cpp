@@ -15,8 +15,8 @@ const std::string& viewer_page_html() {
  #scene { position: absolute; left: 0; top: 32px; right: 0; bottom: 28px; }
  #bar { position: absolute; left: 0; right: 0; top: 0; height: 32px; background: #222; display: flex; gap: 6px; align-items: center; padding: 0 8px; }
  #status { position: absolute; left: 0; right: 0; bottom: 0; height: 28px; line-height: 28px; background: #222; padding: 0 8px; white-space: nowrap; overflow: hidden; }
- #imagebox { position: absolute; right: 8px; top: 40px; width: 36%; max-width: 640px; background: #000; border: 1px solid #444; }
- #image { width: 100%; display: block; }
+ #imagebox { position: absolute; right: 8px; top: 40px; width: 36%; max-width: 640px; background: #000; border: 1px solid #444; line-height: 0; }
+ #image { width: 100%; height: auto; display: block; }
  button, label { color: #ddd; background: #333; border: 1px solid #555; padding: 3px 8px; border-radius: 3px; }
  #legend { margin-left: auto; color: #999; }
 </style></head>
