@@ -24,7 +24,7 @@ for p in "${packages[@]}"; do
   fi
 done
 if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
+  echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
   sudo_cmd=()
   if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
   export DEBIAN_FRONTEND=noninteractive
@@ -34,9 +34,12 @@ fi
 
 jobs="${CROWDSLAM_JOBS:-$(nproc)}"
 if [[ ! -f "$build_dir/build.ninja" ]]; then
+  echo "setup: configuring $build_dir (cmake)"
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${CROWDSLAM_BUILD_TYPE:-Release}" "$@"
 fi
+echo "setup: building with $jobs jobs (ninja shows [done/total]; a first build takes 10-15 minutes on 2 cores)"
 cmake --build "$build_dir" -j "$jobs"
+echo "setup: default vocabulary and person-detector models"
 
 # Default ORB vocabulary (vocabulary/crowdslam_orb.voc, never committed): trained from opencv-doc's
 # sample images in about 10 s; skipped when present with the recorded SHA-256.
@@ -49,3 +52,4 @@ fi
 if ! scripts/install_models.sh >/dev/null; then
   echo "setup: warning: person-detector models not installed (see the error above)" >&2
 fi
+echo "setup: done ($build_dir/apps/crowdslam/crowdslam)"

@@ -4,6 +4,7 @@
 
 #include <cassert>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 
 #include "crowdslam/io/euroc_dataset.h"
@@ -22,6 +23,7 @@
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/interrupt.h"
+#include "crowdslam/util/progress.h"
 #include "crowdslam/util/text.h"
 
 namespace crowdslam::run {
@@ -163,6 +165,8 @@ RunSummary run_sequence(const RunOptions& options) {
   std::optional<SensorPacer> pacer;
   size_t dropped_after_tracking = 0;
   if (options.pace_sensor) pacer.emplace();
+  const size_t progress_total = options.max_frames > 0 && (expected == 0 || options.max_frames < expected) ? options.max_frames : expected;
+  ProgressLine progress(options.progress, progress_total, "frame");
   try {
     while (true) {
       if (const int signal = interrupt_signal()) {
@@ -193,7 +197,13 @@ RunSummary run_sequence(const RunOptions& options) {
       std::vector<cv::KeyPoint>().swap(report.removed_keypoints);
       std::vector<people::PersonBox>().swap(report.boxes);
       journal.check();
-      if (options.progress && reports.size() % 100 == 0) {
+      if (progress.on_terminal()) {  // one line redrawn in place
+        char detail[160];
+        std::snprintf(detail, sizeof detail, "%s  tracked %zu  keyframes %zu  people %.0f %%",
+                      tracking::to_string(report.state), slam.tracked_frames(), slam.num_keyframes(),
+                      100.0 * report.people_area);
+        progress.update(reports.size(), detail);
+      } else if (options.progress && reports.size() % 100 == 0) {  // plain lines in logs and CI
         spdlog::info("frame {}/{}: {} tracked, {} keyframes, {} map points", reports.size(), expected,
                      slam.tracked_frames(), slam.num_keyframes(), slam.num_map_points());
       }
@@ -203,6 +213,7 @@ RunSummary run_sequence(const RunOptions& options) {
     end.reason = e.what();
     error = std::current_exception();
   }
+  progress.finish();
   const double wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
   prefetcher.cancel();
   slam.finish(end);  // stops the threads; the journal drains and closes
