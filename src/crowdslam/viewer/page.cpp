@@ -174,7 +174,7 @@ const std::string& viewer_page_html() {
  let lastRender = 0;
  function renderSoon() {
   const now = performance.now();
-  if (now - lastRender < 100 || params.get('norender')) return;
+  if (now - lastRender < 200 || params.get('norender')) return;
   lastRender = now; dirty = false; renderer.render(scene, camera); renders += 1; body.dataset.renders = String(renders);
  }
  function connect() {
@@ -217,7 +217,7 @@ const std::string& viewer_page_html() {
  controls.addEventListener('change', () => { dirty = true; });
  function animate() {
   requestAnimationFrame(animate);
-  if (!dirty) return;
+  if (!dirty || performance.now() - lastRender < 200) return;  // at most 5 renders a second
   dirty = false;
   if (params.get('norender')) return;
   lastRender = performance.now();
