@@ -8,22 +8,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=5
-build=build
-while [[ $# -gt 0 && "$1" != "--" ]]; do
-  case "$1" in
-    -n) runs="$2"; shift 2 ;;
-    -b) build="$2"; shift 2 ;;
-    *) echo "bench_run: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-[[ "${1:-}" == "--" ]] && shift
-bin="$build/apps/crowdslam/crowdslam"
-[[ -x "$bin" ]] || { echo "bench_run: $bin not built (run scripts/setup.sh)" >&2; exit 1; }
+script=bench_run
+source scripts/lib/run_options.sh
+parse_run_options "$@"
 out=out/bench
 mkdir -p "$out"
 for ((k = 1; k <= runs; ++k)); do
   rm -rf "$out/run_$k"
-  /usr/bin/time -f "%M" -o "$out/run_$k.rss" "$bin" -q run "$@" --out "$out/run_$k" >/dev/null
+  /usr/bin/time -f "%M" -o "$out/run_$k.rss" "$bin" -q run "${run_args[@]}" --out "$out/run_$k" >/dev/null
 done
 python3 - "$out" "$runs" <<'PY'
 import json, statistics, sys

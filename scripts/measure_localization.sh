@@ -9,25 +9,17 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=5
-build=build
-while [[ $# -gt 0 && "$1" != "--" ]]; do
-  case "$1" in
-    -n) runs="$2"; shift 2 ;;
-    -b) build="$2"; shift 2 ;;
-    *) echo "measure_localization: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-[[ "${1:-}" == "--" ]] && shift
-bin="$build/apps/crowdslam/crowdslam"
-[[ -x "$bin" ]] || { echo "measure_localization: $bin not built (run scripts/setup.sh)" >&2; exit 1; }
+script=measure_localization
+source scripts/lib/run_options.sh
+parse_run_options "$@"
 out=out/localization
 rm -rf "$out"
 mkdir -p "$out"
 echo "mapping run (saves $out/map.db) ..."
-"$bin" -q run "$@" --out "$out/mapping" --save-map "$out/map.db" >/dev/null
+"$bin" -q run "${run_args[@]}" --out "$out/mapping" --save-map "$out/map.db" >/dev/null
 for ((k = 1; k <= runs; ++k)); do
   echo "localisation run $k/$runs ..."
-  "$bin" -q run "$@" --out "$out/loc_$k" --load-map "$out/map.db" --localization >/dev/null
+  "$bin" -q run "${run_args[@]}" --out "$out/loc_$k" --load-map "$out/map.db" --localization >/dev/null
 done
 /usr/bin/python3 - "$out" "$runs" <<'PY'
 import json, math, statistics, sys

@@ -1,26 +1,21 @@
 #!/usr/bin/env bash
 # Throughput with the live viewer (issue 13): N runs without --viewer and N with --viewer and a headless
 # Chromium connected to it (on this same machine), alternating; prints each run and the medians.
-#   scripts/measure_viewer.sh [-n RUNS] -- RUN_ARGS...
+#   scripts/measure_viewer.sh [-n RUNS] [-b BUILD_DIR] -- RUN_ARGS...
 # Example: scripts/measure_viewer.sh -n 3 -- --dataset ../shared/data/bonn_crowd --settings config/Bonn.yaml
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=3
-while [[ $# -gt 0 && "$1" != "--" ]]; do
-  case "$1" in
-    -n) runs="$2"; shift 2 ;;
-    *) echo "measure_viewer: unknown option $1" >&2; exit 2 ;;
-  esac
-done
-[[ "${1:-}" == "--" ]] && shift
-bin=build/apps/crowdslam/crowdslam
+script=measure_viewer
+source scripts/lib/run_options.sh
+parse_run_options "$@"
 out=out/viewer
 rm -rf "$out"
 mkdir -p "$out"
 port=8765
 for ((k = 1; k <= runs; ++k)); do
-  "$bin" -q run "$@" --out "$out/plain_$k" >/dev/null
-  "$bin" -q run "$@" --out "$out/viewer_$k" --viewer --viewer-port "$port" >/dev/null 2>"$out/viewer_$k.log" &
+  "$bin" -q run "${run_args[@]}" --out "$out/plain_$k" >/dev/null
+  "$bin" -q run "${run_args[@]}" --out "$out/viewer_$k" --viewer --viewer-port "$port" >/dev/null 2>"$out/viewer_$k.log" &
   pid=$!
   sleep 0.5
   timeout 600 chromium --headless=new --no-sandbox --disable-gpu --enable-unsafe-swiftshader --use-angle=swiftshader \
