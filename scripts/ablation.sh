@@ -34,7 +34,7 @@ echo "| --- | --- | --- | --- |"
 row() {  # label, extra run args...
   local label="$1"; shift
   local line
-  line=$(scripts/bench_run.sh -n "$runs" -b "$build" -- --dataset "$dataset" "$@" | tail -1)
+  line=$(bash scripts/bench_run.sh -n "$runs" -b "$build" -- --dataset "$dataset" "$@" | tail -1)
   python3 - "$label" "$line" <<'PY'
 import re, sys
 label, line = sys.argv[1], sys.argv[2]

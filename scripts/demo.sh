@@ -4,7 +4,7 @@
 #   scripts/demo.sh [OUT_DIR]      (default out/demo)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh build >/dev/null
+bash scripts/setup.sh build
 bin=build/apps/crowdslam/crowdslam
 out="${1:-out/demo}"
 seq="$out/sequence"

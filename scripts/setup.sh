@@ -15,6 +15,7 @@ packages=(
   opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
   libjs-chart.js chromium   # report.html inlines Chart.js; the report tests open it in headless Chromium
   libjs-three libcpp-httplib-dev   # the live viewer: three.js served by our own HTTP server
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (build/python) and its tests
 )
 
 missing=()
@@ -43,13 +44,13 @@ echo "setup: default vocabulary and person-detector models"
 
 # Default ORB vocabulary (vocabulary/crowdslam_orb.voc, never committed): trained from opencv-doc's
 # sample images in about 10 s; skipped when present with the recorded SHA-256.
-if ! scripts/build_vocabulary.sh "$build_dir" >/dev/null; then
+if ! bash scripts/build_vocabulary.sh "$build_dir" >/dev/null; then
   echo "setup: warning: default vocabulary not built (see the error above)" >&2
 fi
 
 # Person-detector models (copied from ../shared or downloaded with a SHA-256 check; never committed).
 # Without them `crowdslam run` needs --no-people-filter or --detections, and detector tests are skipped.
-if ! scripts/install_models.sh >/dev/null; then
+if ! bash scripts/install_models.sh >/dev/null; then
   echo "setup: warning: person-detector models not installed (see the error above)" >&2
 fi
 echo "setup: done ($build_dir/apps/crowdslam/crowdslam)"

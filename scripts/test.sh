@@ -3,5 +3,5 @@
 #   scripts/test.sh [ctest args...]      e.g. scripts/test.sh -L unit
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh build
+bash scripts/setup.sh build
 ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 1200 "$@"
