@@ -69,6 +69,11 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "Person boxes from a MOT-format file (frame,id,x,y,w,h,conf,...) instead of the detector");
   cmd->add_option("--detector", args->options.detector_model, "Detector model: body, coco, PATH.cfg or PATH.onnx");
   cmd->add_option("--filter-mode", args->options.filter_mode, "People filter mode: paper or depth");
+  cmd->add_option("--detector-mode", args->options.detector_mode,
+                  "every_frame: each frame waits for its own boxes; latest: the detector takes the newest frame "
+                  "when free and other frames get its boxes moved by the image flow (Detector.mode)");
+  cmd->add_option("--box-tracker", args->options.box_tracker,
+                  "on: boxes persist through missed detections and one-detection boxes are dropped (Detector.tracker)");
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
   cmd->add_option("--vocabulary", args->options.vocabulary,

@@ -127,3 +127,48 @@ TEST(DetectionWorker, ShutdownWithASubmittedFrameNeverCollected) {
 
 }  // namespace
 }  // namespace crowdslam::people
+
+namespace crowdslam::people {
+namespace {
+
+// Decoupled mode: offer() takes a frame only when the worker is free, poll() never blocks.
+TEST(DetectionWorkerLatest, OfferTakesTheNewestFrameWhenFreeAndPollNeverBlocks) {
+  auto detector = std::make_unique<FakeDetector>(60ms);
+  DetectionWorker worker(std::move(detector));
+  EXPECT_TRUE(worker.idle());
+  EXPECT_FALSE(worker.poll().has_value());
+  cv::Mat image = image_with(5);
+  EXPECT_TRUE(worker.offer(0, image));
+  image.setTo(99);  // offer() copied the pixels: the caller may reuse its buffer at once
+  EXPECT_FALSE(worker.idle());
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(worker.offer(1, image_with(1)));  // busy: frame 1 is skipped
+  EXPECT_FALSE(worker.poll().has_value());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 40ms);  // neither blocked on the 60 ms detection
+  std::optional<WorkerResult> r;
+  while (!(r = worker.poll())) std::this_thread::sleep_for(2ms);
+  EXPECT_EQ(r->frame_index, 0u);
+  ASSERT_EQ(r->detections.boxes.size(), 1u);
+  EXPECT_FLOAT_EQ(r->detections.boxes[0].box.width, 5.0f);  // the pixels as offered, not as overwritten
+  EXPECT_TRUE(worker.idle());
+  EXPECT_TRUE(worker.offer(2, image_with(3)));
+}
+
+TEST(DetectionWorkerLatest, DetectorExceptionReachesPoll) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(0ms, 0));
+  ASSERT_TRUE(worker.offer(0, image_with(1)));
+  bool thrown = false;
+  for (int i = 0; i < 500 && !thrown; ++i) {
+    try {
+      if (!worker.poll()) std::this_thread::sleep_for(2ms);
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "fake failure on frame 0");
+      thrown = true;
+    }
+  }
+  EXPECT_TRUE(thrown);
+  EXPECT_TRUE(worker.offer(1, image_with(1)));  // usable again
+}
+
+}  // namespace
+}  // namespace crowdslam::people

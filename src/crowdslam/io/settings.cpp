@@ -72,11 +72,18 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("Detector.nms"), s.detector.nms);
   set_if(r.integer("Detector.person_class"), s.detector.person_class);
   set_if(r.flag("Detector.filter_before_nms"), s.detector.filter_before_nms);
+  set_if(r.text("Detector.mode"), s.detector.mode);
+  set_if(r.flag("Detector.tracker"), s.detector.tracker);
+  set_if(r.real("Detector.track_iou"), s.detector.track_iou);
+  set_if(r.integer("Detector.track_min_hits"), s.detector.track_min_hits);
+  set_if(r.integer("Detector.track_max_misses"), s.detector.track_max_misses);
+  set_if(r.real("Detector.track_confirm_confidence"), s.detector.track_confirm_confidence);
   set_if(r.flag("PeopleFilter.enabled"), s.people_filter.enabled);
   set_if(r.text("PeopleFilter.mode"), s.people_filter.mode);
   set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
   set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
   set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
+  set_if(r.flag("PeopleFilter.rescue_with_boxes"), s.people_filter.rescue_with_boxes);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
   set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
   set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);

@@ -66,6 +66,15 @@ struct DetectorSettings {
   double nms = 0.1;
   int person_class = 0;
   bool filter_before_nms = true;
+  // "every_frame": detect on every frame, the frame waits for its boxes; "latest": the detector takes the
+  // newest frame when free, other frames get its boxes moved by the image flow (system/people_stage.h).
+  std::string mode = "every_frame";
+  // Short-term box tracks (people/box_tracker.h) and their parameters.
+  bool tracker = false;
+  double track_iou = 0.3;
+  int track_min_hits = 2;
+  int track_max_misses = 2;
+  double track_confirm_confidence = 0.5;
 };
 
 struct PeopleFilterSettings {
@@ -77,6 +86,9 @@ struct PeopleFilterSettings {
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the
   // stereo match of a kept left keypoint whose right coordinate falls in a (left-image) person box.
   std::string right_image = "matched";
+  // When the filtered frame fails to track right after a tracked one, try once more with the keypoints
+  // in the boxes (tracking/tracker.h): a false-positive box over most of the image then costs no tracking.
+  bool rescue_with_boxes = true;
 };
 
 struct FeatureBudgetSettings {

@@ -143,6 +143,15 @@ void check_own_sections(const Checker& c, const Settings& s) {
             "in (0, 1]", d.confidence);
   c.require(std::isfinite(d.nms) && d.nms > 0 && d.nms <= 1, "Detector.nms", "in (0, 1]", d.nms);
   c.require(d.person_class >= 0, "Detector.person_class", ">= 0", d.person_class);
+  c.require(d.mode == "every_frame" || d.mode == "latest", "Detector.mode", "\"every_frame\" or \"latest\"",
+            "\"" + d.mode + "\"");
+  c.require(std::isfinite(d.track_iou) && d.track_iou > 0 && d.track_iou <= 1, "Detector.track_iou", "in (0, 1]",
+            d.track_iou);
+  c.require(d.track_min_hits >= 1, "Detector.track_min_hits", ">= 1", d.track_min_hits);
+  c.require(d.track_max_misses >= 0, "Detector.track_max_misses", ">= 0", d.track_max_misses);
+  c.require(std::isfinite(d.track_confirm_confidence) && d.track_confirm_confidence >= 0 &&
+                d.track_confirm_confidence <= 1,
+            "Detector.track_confirm_confidence", "in [0, 1]", d.track_confirm_confidence);
   const auto& p = s.people_filter;
   c.require(p.mode == "paper" || p.mode == "depth", "PeopleFilter.mode", "\"paper\" or \"depth\"",
             "\"" + p.mode + "\"");

@@ -88,12 +88,16 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nDetector.model_weights: " << quoted(d.model_weights) << "\nDetector.input_size: " << d.input_size
       << "\nDetector.confidence: " << real_text(d.confidence) << "\nDetector.nms: " << real_text(d.nms)
       << "\nDetector.person_class: " << d.person_class
-      << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0) << "\n\n";
+      << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0) << "\nDetector.mode: " << quoted(d.mode)
+      << "\nDetector.tracker: " << (d.tracker ? 1 : 0) << "\nDetector.track_iou: " << real_text(d.track_iou)
+      << "\nDetector.track_min_hits: " << d.track_min_hits << "\nDetector.track_max_misses: " << d.track_max_misses
+      << "\nDetector.track_confirm_confidence: " << real_text(d.track_confirm_confidence) << "\n\n";
   const auto& p = s.people_filter;
   out << "# Keypoints on people (mode \"paper\" or \"depth\")\nPeopleFilter.enabled: " << (p.enabled ? 1 : 0)
       << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
       << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
-      << "\nPeopleFilter.right_image: " << quoted(p.right_image) << "\n\n";
+      << "\nPeopleFilter.right_image: " << quoted(p.right_image)
+      << "\nPeopleFilter.rescue_with_boxes: " << (p.rescue_with_boxes ? 1 : 0) << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "

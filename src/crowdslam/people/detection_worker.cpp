@@ -53,6 +53,40 @@ WorkerResult DetectionWorker::wait(std::size_t frame_index) {
   return out;
 }
 
+bool DetectionWorker::offer(std::size_t frame_index, const cv::Mat& bgr) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_ != State::kIdle) return false;
+    frame_index_ = frame_index;
+    image_ = bgr.clone();  // the caller does not wait for the result, so it may reuse its buffer
+    error_ = nullptr;
+    state_ = State::kPending;
+  }
+  wake_worker_.notify_one();
+  return true;
+}
+
+bool DetectionWorker::idle() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return state_ == State::kIdle;
+}
+
+std::optional<WorkerResult> DetectionWorker::poll() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (state_ != State::kDone) return std::nullopt;
+  WorkerResult out;
+  out.frame_index = frame_index_;
+  state_ = State::kIdle;
+  image_.release();
+  if (error_) {
+    std::exception_ptr error = std::exchange(error_, nullptr);
+    std::rethrow_exception(error);
+  }
+  out.detections = std::move(result_);
+  result_ = {};
+  return out;
+}
+
 void DetectionWorker::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {

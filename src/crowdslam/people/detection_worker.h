@@ -12,13 +12,21 @@
 // a detection that is running is finished first (a forward pass cannot be interrupted), a submitted
 // frame that has not started is dropped.
 //
-// Thread safety: submit() and wait() are meant for one caller thread (tracking); all state shared with the
+// Decoupled use (Detector.mode: latest), so a slow detector never holds tracking up:
+//
+//   if (worker.idle()) worker.offer(k, colour);   // the worker copies the image and starts on it
+//   if (auto r = worker.poll()) ...               // a finished result (of an earlier frame), or nothing
+//
+// offer() returns false (and does nothing) while a frame is in flight or its result was not collected.
+//
+// Thread safety: submit(), wait(), offer() and poll() are meant for one caller thread (tracking); all state shared with the
 // worker thread is guarded by one mutex.
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "crowdslam/people/detector.h"
@@ -40,6 +48,12 @@ class DetectionWorker {
 
   void submit(std::size_t frame_index, cv::Mat bgr);
   WorkerResult wait(std::size_t frame_index);
+  // Decoupled mode: starts on a copy of `bgr` when no frame is in flight; false when busy.
+  bool offer(std::size_t frame_index, const cv::Mat& bgr);
+  // The finished result, if there is one (never blocks); rethrows the detector's exception.
+  std::optional<WorkerResult> poll();
+  // No frame in flight and no result waiting: offer() would start.
+  [[nodiscard]] bool idle();
 
   [[nodiscard]] const PersonDetector& detector() const { return *detector_; }
 

@@ -46,6 +46,9 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"keypoints_before_filter", r.keypoints_before_filter},
           {"detector_ms", r.detector_ms},
           {"detector_wait_ms", r.detector_wait_ms},
+          {"detection_frame", r.detection_frame},
+          {"boxes_propagated", r.boxes_propagated},
+          {"rescued_with_boxes", r.rescued_with_boxes},
           {"stereo_matches", r.stereo_matches},
           {"right_keypoints_removed", r.right_keypoints_removed},
           {"right_wait_ms", r.right_wait_ms},
@@ -184,19 +187,32 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     doc["vocabulary"] = nullptr;
   }
   std::vector<double> detector_ms, detector_wait_ms;
+  int rescued = 0;
   double waited_for_mapping_ms = 0;
   int frames_waited = 0;
   for (const auto& r : reports) {
-    detector_ms.push_back(r.detector_ms);
+    rescued += r.rescued_with_boxes ? 1 : 0;
+    if (r.detector_ms > 0) detector_ms.push_back(r.detector_ms);  // latest mode: frames with a new detection
     detector_wait_ms.push_back(r.detector_wait_ms);
     waited_for_mapping_ms += r.waited_for_mapping_ms;
     frames_waited += r.waited_for_mapping_ms > 0 ? 1 : 0;
   }
-  doc["people_filter"] = slam.people_filter_enabled()
+  const system::PeopleStage* people = slam.people_stage();
+  doc["people_filter"] = people != nullptr
                              ? nlohmann::json{{"detector", slam.detector_name()},
+                                              {"detector_mode", system::to_string(people->mode())},
+                                              {"box_tracker", people->tracker_enabled()},
+                                              {"detections", people->stats().detections},
+                                              {"frames_detected", people->stats().frames_detected},
+                                              {"frames_propagated", people->stats().frames_propagated},
+                                              {"boxes_moved", people->stats().boxes_moved},
+                                              {"boxes_kept_in_place", people->stats().boxes_kept_in_place},
+                                              {"tracks_started", people->stats().tracks_started},
                                               {"mode", s.people_filter.mode},
                                               {"margin_px", s.people_filter.margin_px},
                                               {"filter_before_nms", s.detector.filter_before_nms},
+                                              {"rescue_with_boxes", s.people_filter.rescue_with_boxes},
+                                              {"frames_rescued_with_boxes", rescued},
                                               {"feature_budget", s.feature_budget.enabled},
                                               {"area", s.feature_budget.area},
                                               {"detector_ms_median", percentile(detector_ms, 0.5)},

@@ -96,6 +96,19 @@ Prepared prepare(const RunOptions& options) {
     }
     p.run_settings.people_filter.mode = options.filter_mode;
   }
+  if (!options.detector_mode.empty()) {
+    if (options.detector_mode != "every_frame" && options.detector_mode != "latest") {
+      throw InputError("--detector-mode: expected 'every_frame' or 'latest', got '" +
+                       clip_text(options.detector_mode, 60) + "'");
+    }
+    p.run_settings.detector.mode = options.detector_mode;
+  }
+  if (!options.box_tracker.empty()) {
+    if (options.box_tracker != "on" && options.box_tracker != "off") {
+      throw InputError("--box-tracker: expected 'on' or 'off', got '" + clip_text(options.box_tracker, 60) + "'");
+    }
+    p.run_settings.detector.tracker = options.box_tracker == "on";
+  }
   if (p.sensor == io::SensorKind::kStereo) prepare_stereo_settings(*p.source, p.run_settings);
   check_first_frame(*p.source, p.settings);
   return p;

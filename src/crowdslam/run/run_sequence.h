@@ -44,6 +44,8 @@ struct RunOptions {
   std::string detections_file;      // --detections: MOT-format boxes instead of the network
   std::string detector_model;       // --detector: body | coco | PATH.cfg | PATH.onnx
   std::string filter_mode;          // --filter-mode: overrides PeopleFilter.mode (paper | depth)
+  std::string detector_mode;        // --detector-mode: overrides Detector.mode (every_frame | latest)
+  std::string box_tracker;          // --box-tracker: overrides Detector.tracker (on | off)
   size_t save_frames = 0;           // --save-frames N: every N-th frame drawn into OUT/frames/
   std::string vocabulary;           // --vocabulary FILE | none ("" = the default vocabulary)
   bool loop_closing = true;         // --no-loop-closing

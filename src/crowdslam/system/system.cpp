@@ -10,9 +10,6 @@
 #include "crowdslam/bow/vocabulary_path.h"
 #include "crowdslam/feature/orb_extractor.h"
 #include "crowdslam/map/keyframe.h"
-#include "crowdslam/people/darknet_detector.h"
-#include "crowdslam/people/model_paths.h"
-#include "crowdslam/people/mot_file_detector.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::system {
@@ -22,25 +19,6 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
 
-constexpr double kSparseDepthFactor = 1000.0;  // millimetres in the stereo sparse depth image
-
-// CV_16UC1 image (depth * factor, 0 = none) with each keypoint's stereo depth written into a square
-// block. people::estimate_person_depth samples a box every sqrt(area / 2000) pixels; blocks that wide are
-// sampled at least once, so every keypoint in a box's centre counts.
-cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vector<float>& depth_m, cv::Size size,
-                           double factor) {
-  cv::Mat image(size, CV_16UC1, cv::Scalar(0));
-  const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(size.area() / 2000.0))));
-  const cv::Rect inside(0, 0, size.width, size.height);
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const double value = depth_m[i] * factor;
-    if (!(value > 0) || value > 65535) continue;
-    const cv::Rect block =
-        cv::Rect(cvRound(keys[i].pt.x) - side / 2, cvRound(keys[i].pt.y) - side / 2, side, side) & inside;
-    if (block.area() > 0) image(block).setTo(static_cast<uint16_t>(value));
-  }
-  return image;
-}
 }  // namespace
 
 geometry::PinholeCamera camera_from_settings(const io::Settings& settings, io::SensorKind sensor) {
@@ -112,7 +90,13 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   }
 
   next_feature_budget_ = frame_builder_->default_num_features();
-  if (options.people_filter && settings.people_filter.enabled) start_people_filter(settings);
+  if (options.people_filter && settings.people_filter.enabled) {
+    PeopleStageOptions people_options;
+    people_options.sensor = options.sensor;
+    people_options.detections_file = options.detections_file;
+    people_options.detector_model = options.detector_model;
+    people_ = std::make_unique<PeopleStage>(settings, people_options);
+  }
   if (!options.sequential) mapper_->start();
 }
 
@@ -138,123 +122,7 @@ void System::load_vocabulary() {
                vocabulary_->k(), vocabulary_->levels(), vocabulary_info_->load_ms);
 }
 
-void System::start_people_filter(const io::Settings& settings) {
-  people::DetectorOptions detector_options;
-  detector_options.input_size = settings.detector.input_size;
-  detector_options.confidence = settings.detector.confidence;
-  detector_options.nms = settings.detector.nms;
-  detector_options.person_class = settings.detector.person_class;
-  std::unique_ptr<people::PersonDetector> detector;
-  if (!options_.detections_file.empty()) {
-    detector = std::make_unique<people::MotFileDetector>(options_.detections_file, detector_options);
-  } else {
-    std::string spec = options_.detector_model.empty() ? settings.detector.model_cfg : options_.detector_model;
-    if (spec.empty()) spec = "body";
-    people::ModelFiles model = people::resolve_model(spec);
-    if (!settings.detector.model_weights.empty() && options_.detector_model.empty()) {
-      model.weights = settings.detector.model_weights;
-    }
-    if (spec != "body" && spec != "coco") model.person_class = settings.detector.person_class;
-    detector_options.person_class = model.person_class;
-    detector = std::make_unique<people::DarknetDetector>(model, detector_options);
-  }
-  detection_worker_ = std::make_unique<people::DetectionWorker>(std::move(detector));
-
-  filter_options_.mode = people::parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
-  filter_options_.margin_px = settings.people_filter.margin_px;
-  filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
-  right_image_boxes_ = settings.people_filter.right_image == "boxes";
-  filter_options_.check();
-  filter_before_nms_ = settings.detector.filter_before_nms;
-
-  budget_options_.base_features = settings.orb.n_features;
-  budget_options_.enabled = settings.feature_budget.enabled;
-  budget_options_.thresholds = settings.feature_budget.thresholds;
-  budget_options_.factors = settings.feature_budget.factors;
-  area_mode_ = settings.feature_budget.area == "union" ? people::AreaMode::kUnion : people::AreaMode::kSum;
-}
-
-std::string System::detector_name() const {
-  return detection_worker_ ? detection_worker_->detector().name() : std::string("none");
-}
-
-void System::filter_people(size_t frame_index, const io::FrameImages& images, tracking::RawFeatures& raw,
-                           FrameReport& report) {
-  const people::WorkerResult result = detection_worker_->wait(frame_index);
-  const auto& boxes = filter_before_nms_ ? result.detections.raw : result.detections.boxes;
-  report.detector_ms = result.detections.time_ms;
-  report.detector_wait_ms = result.waited_ms;
-  report.person_boxes = static_cast<int>(result.detections.boxes.size());
-  report.keypoints_before_filter = static_cast<int>(raw.keys.size());
-
-  std::vector<float> depth_m;
-  const bool rgbd = options_.sensor == io::SensorKind::kRgbd && !images.depth.empty();
-  if (filter_options_.mode == people::FilterMode::kDepth && rgbd) {
-    depth_m.resize(raw.keys.size(), -1.0f);
-    for (size_t i = 0; i < raw.keys.size(); ++i) {
-      const int x = cvRound(raw.keys[i].pt.x);
-      const int y = cvRound(raw.keys[i].pt.y);
-      if (x < 0 || y < 0 || x >= images.depth.cols || y >= images.depth.rows) continue;
-      const uint16_t d = images.depth.at<uint16_t>(y, x);
-      if (d > 0) depth_m[i] = static_cast<float>(d / settings_.depth_map_factor);
-    }
-  }
-  // Stereo: the keypoints' depths come from stereo matching, which runs before the filter; each person's
-  // depth is estimated from them through a sparse depth image.
-  cv::Mat stereo_depth;
-  const bool stereo = options_.sensor == io::SensorKind::kStereo && raw.depth_m.size() == raw.keys.size();
-  if (filter_options_.mode == people::FilterMode::kDepth && stereo && !boxes.empty()) {
-    depth_m = raw.depth_m;
-    stereo_depth = sparse_depth_image(raw.keys, raw.depth_m, images.colour.size(), kSparseDepthFactor);
-  }
-  const double depth_factor =
-      stereo ? kSparseDepthFactor : (settings_.depth_map_factor > 0 ? settings_.depth_map_factor : 1.0);
-  const people::FilterResult filtered = people::filter_keypoints(
-      raw.keys, boxes, filter_options_, depth_m, rgbd ? images.depth : stereo_depth, depth_factor);
-  if (filtered.removed > 0) {
-    tracking::RawFeatures kept;
-    kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));
-    kept.descriptors.create(static_cast<int>(raw.keys.size()) - filtered.removed, raw.descriptors.cols, raw.descriptors.type());
-    int row = 0;
-    for (size_t i = 0; i < raw.keys.size(); ++i) {
-      if (filtered.keep[i]) {
-        raw.descriptors.row(static_cast<int>(i)).copyTo(kept.descriptors.row(row++));
-        kept.keys.push_back(raw.keys[i]);
-        if (stereo) {
-          kept.right_u.push_back(raw.right_u[i]);
-          kept.depth_m.push_back(raw.depth_m[i]);
-        }
-      } else if (options_.record_keypoints) {
-        report.removed_keypoints.push_back(raw.keys[i]);
-      }
-    }
-    raw = std::move(kept);
-  }
-  if (stereo && right_image_boxes_) {
-    // The boxes are the left image's, used unshifted on the right image.
-    for (size_t i = 0; i < raw.keys.size(); ++i) {
-      if (raw.right_u[i] < 0) continue;
-      const cv::Point2f right(raw.right_u[i], raw.keys[i].pt.y);
-      for (const auto& box : boxes) {
-        if (box.box.contains(right)) {
-          raw.right_u[i] = -1.0f;
-          raw.depth_m[i] = -1.0f;
-          ++report.right_keypoints_removed;
-          break;
-        }
-      }
-    }
-  }
-  // Feature number update for the next frame.
-  budget_options_.image_width = images.colour.cols;
-  budget_options_.image_height = images.colour.rows;
-  // The covered area always comes from the boxes kept by NMS: the raw boxes overlap heavily, and their
-  // summed area says nothing about how much of the image people cover.
-  report.people_area =
-      people::covered_fraction(result.detections.boxes, images.colour.cols, images.colour.rows, area_mode_);
-  next_feature_budget_ = people::feature_budget(report.people_area, budget_options_);
-  report.boxes = boxes;
-}
+std::string System::detector_name() const { return people_ ? people_->detector_name() : std::string("none"); }
 
 System::~System() { shutdown(); }
 
@@ -332,9 +200,9 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
       frame_builder_->extract_right(right_gray, budget, raw_right);
     });
   }
-  // The detector works on this frame on its own thread while ORB features are extracted here.
-  if (detection_worker_) detection_worker_->submit(frame_index, left_colour);
+  // The detector works on its own thread while ORB features are extracted here.
   const cv::Mat gray = feature::to_gray(left_colour);
+  if (people_) people_->begin_frame(frame_index, left_colour, gray);
   tracking::RawFeatures raw;
   frame_builder_->extract(gray, report.feature_budget, raw);
   report.keypoints_before_filter = static_cast<int>(raw.keys.size());
@@ -347,7 +215,26 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     frame_builder_->match_stereo(raw, raw_right);
     report.stereo_match_ms = elapsed_ms(match_start);
   }
-  if (detection_worker_) filter_people(frame_index, images, raw, report);
+  // The keypoints before the filter: tracking may try them when the filtered frame fails (Tracker::track).
+  std::optional<tracking::RawFeatures> unfiltered;
+  if (people_) {
+    if (settings_.people_filter.rescue_with_boxes) {
+      unfiltered.emplace(tracking::RawFeatures{raw.keys, raw.descriptors.clone(), raw.right_u, raw.depth_m});
+    }
+    PeopleFrame p = people_->filter(frame_index, images, raw, options_.record_keypoints);
+    report.person_boxes = p.person_boxes;
+    report.people_area = p.people_area;
+    report.keypoints_before_filter = p.keypoints_before_filter;
+    report.detector_ms = p.detector_ms;
+    report.detector_wait_ms = p.detector_wait_ms;
+    report.right_keypoints_removed = p.right_keypoints_removed;
+    report.detection_frame = p.detection_frame;
+    report.boxes_propagated = p.boxes_propagated;
+    report.boxes = std::move(p.boxes);
+    report.removed_keypoints = std::move(p.removed_keypoints);
+    next_feature_budget_ = people_->next_feature_budget();
+    if (unfiltered && unfiltered->keys.size() == raw.keys.size()) unfiltered.reset();  // nothing was removed
+  }
   if (options_.record_keypoints) report.kept_keypoints = raw.keys;
   std::shared_ptr<map::FrameFeatures> features;
   if (stereo) {
@@ -363,7 +250,15 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
 
   const auto tracking_start = std::chrono::steady_clock::now();
   map::Frame frame(next_frame_id_++, timestamp_s, camera_, frame_builder_->levels(), std::move(features));
-  const tracking::TrackResult result = tracker_->track(std::move(frame));
+  tracking::Tracker::UnfilteredFeatures unfiltered_features;
+  if (unfiltered) {
+    unfiltered_features = [&]() -> std::shared_ptr<const map::FrameFeatures> {
+      if (stereo) return frame_builder_->assemble_stereo(std::move(*unfiltered));
+      const cv::Mat depth = options_.sensor == io::SensorKind::kRgbd ? images.depth : cv::Mat();
+      return frame_builder_->assemble(std::move(*unfiltered), depth);
+    };
+  }
+  const tracking::TrackResult result = tracker_->track(std::move(frame), unfiltered_features);
   if (options_.sequential) {
     mapper_->process_all();
     if (loop_closer_) loop_closer_->process_all();
@@ -373,6 +268,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.state = result.state;
   report.method = result.method;
   report.new_keyframe = result.new_keyframe;
+  report.rescued_with_boxes = result.rescued_with_boxes;
   report.waited_for_mapping_ms = result.waited_for_mapping_ms;
   report.tracked_points = result.tracked_points;
 

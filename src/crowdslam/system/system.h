@@ -14,9 +14,7 @@
 #include "crowdslam/loop/loop_closer.h"
 #include "crowdslam/mapdb/map_database.h"
 #include "crowdslam/mapping/local_mapper.h"
-#include "crowdslam/people/detection_worker.h"
-#include "crowdslam/people/feature_budget.h"
-#include "crowdslam/people/keypoint_filter.h"
+#include "crowdslam/system/people_stage.h"
 #include "crowdslam/system/run_observer.h"
 #include "crowdslam/system/stereo_rectifier.h"
 #include "crowdslam/tracking/frame_builder.h"
@@ -72,6 +70,9 @@ struct FrameReport {
   int keypoints_before_filter = 0;
   double detector_ms = 0;      // detector forward time (runs on its own thread)
   double detector_wait_ms = 0; // how long tracking waited for the boxes after ORB extraction
+  int64_t detection_frame = -1;  // frame the boxes were detected on (-1: none yet)
+  bool boxes_propagated = false; // boxes moved here from an earlier frame (Detector.mode latest)
+  bool rescued_with_boxes = false;  // tracked only with the keypoints in boxes added back (Tracker::track)
   int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
   // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).
@@ -136,8 +137,10 @@ class System {
   [[nodiscard]] loop::LoopCloserStats loop_stats() const;
   [[nodiscard]] bool loop_closing_enabled() const { return loop_closer_ != nullptr; }
   [[nodiscard]] int map_resets() const { return map_resets_; }
-  [[nodiscard]] bool people_filter_enabled() const { return detection_worker_ != nullptr; }
+  [[nodiscard]] bool people_filter_enabled() const { return people_ != nullptr; }
   [[nodiscard]] std::string detector_name() const;
+  // The people filter's stage (null when the filter is off).
+  [[nodiscard]] const PeopleStage* people_stage() const { return people_.get(); }
   // Empty when running without a vocabulary.
   [[nodiscard]] const std::optional<VocabularyInfo>& vocabulary_info() const { return vocabulary_info_; }
 
@@ -159,10 +162,6 @@ class System {
   [[nodiscard]] io::Trajectory live_keyframe_trajectory() const;
   // Reads options_.vocabulary_path into vocabulary_ (nothing for "none"); throws InputError.
   void load_vocabulary();
-  void start_people_filter(const io::Settings& settings);
-  // Waits for the frame's boxes and removes the keypoints on people; updates the next frame's budget.
-  void filter_people(size_t frame_index, const io::FrameImages& images, tracking::RawFeatures& raw,
-                     FrameReport& report);
 
   io::Settings settings_;
   SystemOptions options_;
@@ -180,12 +179,7 @@ class System {
   std::vector<MapSegment> segments_;           // the last one is the current map
   io::Trajectory past_keyframes_;              // keyframes of maps that were reset
   std::vector<RunObserver*> observers_;
-  std::unique_ptr<people::DetectionWorker> detection_worker_;
-  people::KeypointFilterOptions filter_options_;
-  people::FeatureBudgetOptions budget_options_;
-  people::AreaMode area_mode_ = people::AreaMode::kSum;
-  bool filter_before_nms_ = true;
-  bool right_image_boxes_ = false;  // PeopleFilter.right_image: boxes
+  std::unique_ptr<PeopleStage> people_;  // null when the people filter is off
   int next_feature_budget_ = 0;
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;

@@ -44,6 +44,7 @@ Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, K
 }
 
 void Tracker::reset() {
+  lost_frames_ = 0;
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
   velocity_.reset();
@@ -63,7 +64,7 @@ void Tracker::start_in_loaded_map(bool localization_only) {
   localization_only_ = localization_only;
 }
 
-TrackResult Tracker::track(map::Frame frame) {
+TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltered) {
   TrackResult result;
   result.keypoints = static_cast<int>(frame.size());
   std::unique_lock map_lock(map_->update_mutex());
@@ -76,6 +77,7 @@ TrackResult Tracker::track(map::Frame frame) {
     }
   } else {
     bool ok = false;
+    const bool was_tracking = state_ == TrackingState::kOk && velocity_ && last_frame_;
     if (last_frame_) replace_replaced_points(*last_frame_);
     if (state_ == TrackingState::kOk && velocity_ && last_frame_) {
       ok = track_with_motion_model(frame);
@@ -91,10 +93,25 @@ TrackResult Tracker::track(map::Frame frame) {
     }
     frame.reference_keyframe = reference_keyframe_;
     if (ok) ok = track_local_map(frame);
+    if (!ok && was_tracking && unfiltered && velocity_) {
+      if (auto features = unfiltered()) {
+        map::Frame full(frame.id, frame.timestamp_s, frame.camera, frame.levels, std::move(features));
+        if (track_with_motion_model(full)) {
+          full.reference_keyframe = reference_keyframe_;
+          if (track_local_map(full)) {
+            frame = std::move(full);
+            ok = true;
+            result.method = "motion+boxes";
+            result.rescued_with_boxes = true;
+          }
+        }
+      }
+    }
     state_ = ok ? TrackingState::kOk : TrackingState::kLost;
     if (!ok) result.method = "lost";
 
     if (ok) {
+      lost_frames_ = 0;
       if (last_frame_ && last_frame_->cam_from_world) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else {
@@ -105,7 +122,8 @@ TrackResult Tracker::track(map::Frame frame) {
         if (p && p->num_observations() < 1) p.reset();
       }
       temporal_points_.clear();
-      KeyframeDecision decision = localization_only_ ? KeyframeDecision::kNo : need_new_keyframe(frame);
+      KeyframeDecision decision = localization_only_ || result.rescued_with_boxes ? KeyframeDecision::kNo
+                                                                                   : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
         // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
         // mapper can write its bundle adjustment back) rather than track on without new points.
@@ -125,8 +143,13 @@ TrackResult Tracker::track(map::Frame frame) {
       frame.discard_outliers();
     } else {
       velocity_.reset();
+      ++lost_frames_;
       if (!map_loaded_ && map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
+        result.map_reset = true;
+      } else if (!map_loaded_ && options_.new_map_after_lost_frames > 0 &&
+                 lost_frames_ >= options_.new_map_after_lost_frames) {
+        spdlog::warn("tracking lost for {} frames without relocalising: starting a new map", lost_frames_);
         result.map_reset = true;
       }
     }

@@ -3,6 +3,7 @@
 // motion-model and reference-keyframe tracking, local-map tracking, and keyframe creation.
 // Runs on the caller's thread; hands keyframes to a KeyframeConsumer (the local mapper).
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -41,6 +42,11 @@ struct TrackerOptions {
   // (ORB-SLAM2 uses 0.75 for RGB-D; more keyframes measured better, see docs/RESULTS.md).
   double keyframe_reference_ratio = 0.9;
   int reset_if_lost_within_keyframes = 5;  // lost with so few keyframes: reset the map and start again
+  // Lost for this many frames in a row without relocalising: start a new map (0 = never; ORB-SLAM2 stays
+  // lost until the camera returns, ORB-SLAM3's Atlas starts a new map at once). The camera is somewhere the
+  // map does not cover; a new map tracks it from here on, and the old map's poses stay in the outputs as
+  // their own segment. Never with a loaded map. Usually one second of frames.
+  int new_map_after_lost_frames = 30;
   optim::PoseOptimizerOptions pose;
   // Monocular: two-view initialisation, ORB-SLAM2's monocular keyframe policy, points only by
   // triangulation (local mapper). See tracker_monocular.cpp.
@@ -58,7 +64,9 @@ struct TrackResult {
   bool map_reset = false;
   int tracked_points = 0;   // inliers after local-map tracking
   int keypoints = 0;
-  const char* method = "";  // "init", "motion", "reference", "relocalization", "lost"
+  const char* method = "";  // "init", "motion", "reference", "relocalization", "motion+boxes", "lost"
+  // Tracked only with the keypoints inside person boxes added back (see Tracker::track).
+  bool rescued_with_boxes = false;
   double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
 };
 
@@ -66,8 +74,17 @@ class Tracker {
  public:
   Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, KeyframeConsumer* mapper);
 
+  // The frame's features before the people filter removed any (built only when asked for).
+  using UnfilteredFeatures = std::function<std::shared_ptr<const map::FrameFeatures>()>;
+
   // Tracks one frame; `frame` is consumed (kept as the last frame).
-  TrackResult track(map::Frame frame);
+  // `unfiltered` (optional): when the filtered frame fails to track right after a tracked one, tracking
+  // is tried once more with every keypoint, boxes included, from the motion model: the pose optimisation's
+  // chi-square test keeps only matches that move with the camera. A person box that is a false positive
+  // (a poster, a textured wall) covering most of the image then costs no tracking; keypoints on people
+  // who really move are rejected as outliers. Such a frame never becomes a keyframe (no map points are
+  // created from keypoints in boxes). Reported as method "motion+boxes".
+  TrackResult track(map::Frame frame, const UnfilteredFeatures& unfiltered = {});
 
   // Place recognition for relocalisation (optional; not owned). With it, frames that have a bag of words
   // relocalise against the database's candidates; without it, against recent keyframes (brute force).
@@ -120,6 +137,7 @@ class Tracker {
   std::shared_ptr<map::KeyFrame> last_keyframe_;
   uint64_t last_keyframe_frame_id_ = 0;
   uint64_t last_relocalization_frame_id_ = 0;
+  int lost_frames_ = 0;  // consecutive lost frames (new_map_after_lost_frames)
   int inliers_in_local_map_ = 0;
   bool map_loaded_ = false;
   bool localization_only_ = false;

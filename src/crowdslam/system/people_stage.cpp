@@ -1,0 +1,318 @@
+#include "crowdslam/system/people_stage.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "crowdslam/people/darknet_detector.h"
+#include "crowdslam/people/model_paths.h"
+#include "crowdslam/people/mot_file_detector.h"
+#include "crowdslam/util/error.h"
+
+namespace crowdslam::system {
+namespace {
+
+constexpr double kSparseDepthFactor = 1000.0;  // millimetres in the stereo sparse depth image
+
+// CV_16UC1 image (depth * factor, 0 = none) with each keypoint's stereo depth written into a square
+// block. people::estimate_person_depth samples a box every sqrt(area / 2000) pixels; blocks that wide are
+// sampled at least once, so every keypoint in a box's centre counts.
+cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vector<float>& depth_m, cv::Size size,
+                           double factor) {
+  cv::Mat image(size, CV_16UC1, cv::Scalar(0));
+  const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(size.area() / 2000.0))));
+  const cv::Rect inside(0, 0, size.width, size.height);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const double value = depth_m[i] * factor;
+    if (!(value > 0) || value > 65535) continue;
+    const cv::Rect block =
+        cv::Rect(cvRound(keys[i].pt.x) - side / 2, cvRound(keys[i].pt.y) - side / 2, side, side) & inside;
+    if (block.area() > 0) image(block).setTo(static_cast<uint16_t>(value));
+  }
+  return image;
+}
+
+std::unique_ptr<people::PersonDetector> make_detector(const io::Settings& settings,
+                                                      const PeopleStageOptions& options) {
+  people::DetectorOptions detector_options;
+  detector_options.input_size = settings.detector.input_size;
+  detector_options.confidence = settings.detector.confidence;
+  detector_options.nms = settings.detector.nms;
+  detector_options.person_class = settings.detector.person_class;
+  if (!options.detections_file.empty()) {
+    return std::make_unique<people::MotFileDetector>(options.detections_file, detector_options);
+  }
+  std::string spec = options.detector_model.empty() ? settings.detector.model_cfg : options.detector_model;
+  if (spec.empty()) spec = "body";
+  people::ModelFiles model = people::resolve_model(spec);
+  if (!settings.detector.model_weights.empty() && options.detector_model.empty()) {
+    model.weights = settings.detector.model_weights;
+  }
+  if (spec != "body" && spec != "coco") model.person_class = settings.detector.person_class;
+  detector_options.person_class = model.person_class;
+  return std::make_unique<people::DarknetDetector>(model, detector_options);
+}
+
+}  // namespace
+
+DetectorMode parse_detector_mode(const std::string& name, const std::string& key) {
+  if (name == "every_frame") return DetectorMode::kEveryFrame;
+  if (name == "latest") return DetectorMode::kLatest;
+  throw InputError(key + ": unknown detector mode '" + name + "' (expected every_frame or latest)");
+}
+
+const char* to_string(DetectorMode mode) { return mode == DetectorMode::kLatest ? "latest" : "every_frame"; }
+
+PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions& options)
+    : sensor_(options.sensor),
+      depth_map_factor_(settings.depth_map_factor > 0 ? settings.depth_map_factor : 1.0),
+      worker_(std::make_unique<people::DetectionWorker>(make_detector(settings, options))) {
+  mode_ = parse_detector_mode(settings.detector.mode, "Detector.mode");
+  if (settings.detector.tracker) {
+    people::BoxTrackerOptions t;
+    t.iou = settings.detector.track_iou;
+    t.min_hits = settings.detector.track_min_hits;
+    t.max_misses = settings.detector.track_max_misses;
+    t.confirm_confidence = settings.detector.track_confirm_confidence;
+    tracker_.emplace(t);
+  }
+  filter_options_.mode = people::parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
+  filter_options_.margin_px = settings.people_filter.margin_px;
+  filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
+  filter_options_.check();
+  right_image_boxes_ = settings.people_filter.right_image == "boxes";
+  filter_before_nms_ = settings.detector.filter_before_nms;
+  budget_options_.base_features = settings.orb.n_features;
+  budget_options_.enabled = settings.feature_budget.enabled;
+  budget_options_.thresholds = settings.feature_budget.thresholds;
+  budget_options_.factors = settings.feature_budget.factors;
+  area_mode_ = settings.feature_budget.area == "union" ? people::AreaMode::kUnion : people::AreaMode::kSum;
+  spdlog::info("people detector {}: mode {}, tracker {}", worker_->detector().name(), to_string(mode_),
+               tracker_ ? "on" : "off");
+}
+
+namespace {
+// Reseeds the corners of boxes that have few left (lost to occlusion and the forward-backward check).
+void reseed_thin(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const people::BoxFlowOptions& options) {
+  std::vector<size_t> thin;
+  std::vector<people::FlowBox> reseed;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (static_cast<int>(boxes[i].points.size()) < 2 * options.min_points) {
+      thin.push_back(i);
+      reseed.push_back(boxes[i]);
+    }
+  }
+  if (reseed.empty()) return;
+  people::seed_points(gray, reseed, options);
+  for (size_t k = 0; k < thin.size(); ++k) boxes[thin[k]].points = std::move(reseed[k].points);
+}
+}  // namespace
+
+// Moves `boxes` from `from` to `to`; `nms` (one flag per box, may be empty) follows its boxes.
+void PeopleStage::flow(const cv::Mat& from, const cv::Mat& to, std::vector<people::FlowBox>& boxes,
+                       std::vector<bool>* nms) {
+  std::vector<int> ids;
+  ids.reserve(boxes.size());
+  for (const auto& b : boxes) ids.push_back(b.track_id);
+  for (size_t i = 0; i < boxes.size(); ++i) boxes[i].track_id = static_cast<int>(i);
+  const people::FlowStats s = people::move_boxes(from, to, boxes, flow_options_);
+  stats_.boxes_moved += s.boxes_moved;
+  stats_.boxes_kept_in_place += s.boxes_kept;
+  std::vector<bool> flags;
+  for (auto& b : boxes) {
+    const size_t original = static_cast<size_t>(b.track_id);
+    if (nms != nullptr && !nms->empty()) flags.push_back((*nms)[original]);
+    b.track_id = ids[original];
+  }
+  if (nms != nullptr) *nms = std::move(flags);
+}
+
+void PeopleStage::move_to(const cv::Mat& gray) {
+  if (!current_gray_.empty() && current_gray_.size() == gray.size() && current_gray_.data != gray.data) {
+    if (tracker_) {
+      std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
+      if (!boxes.empty()) {
+        flow(current_gray_, gray, boxes, nullptr);
+        reseed_thin(gray, boxes, flow_options_);
+        tracker_->apply_moved(boxes);
+      }
+    } else if (!boxes_.empty()) {
+      flow(current_gray_, gray, boxes_, &nms_);
+      reseed_thin(gray, boxes_, flow_options_);
+    }
+  }
+  current_gray_ = gray;
+}
+
+void PeopleStage::take_detection(people::WorkerResult result, const cv::Mat& gray) {
+  ++stats_.detections;
+  fresh_ = true;
+  detection_frame_ = static_cast<int64_t>(result.frame_index);
+  detection_ms_ = result.detections.time_ms;
+  const bool use_raw = filter_before_nms_ && !tracker_;
+  const auto& source = use_raw ? result.detections.raw : result.detections.boxes;
+  std::vector<people::FlowBox> detected = people::to_flow_boxes(source);
+  std::vector<bool> nms(detected.size(), true);
+  if (use_raw) {
+    for (size_t i = 0; i < detected.size(); ++i) {
+      const auto& box = detected[i].box.box;
+      nms[i] = std::any_of(result.detections.boxes.begin(), result.detections.boxes.end(),
+                           [&](const people::PersonBox& b) { return b.box == box; });
+    }
+  }
+  // Latest mode: the detection was made on an earlier frame; move it from that frame's image to this one.
+  const bool older = mode_ == DetectorMode::kLatest && !offered_gray_.empty() &&
+                     offered_gray_.size() == gray.size() && offered_gray_.data != gray.data;
+  if (older) {
+    people::seed_points(offered_gray_, detected, flow_options_);
+    flow(offered_gray_, gray, detected, &nms);
+  }
+  if (tracker_) {
+    const people::TrackerUpdate u = tracker_->update(people::to_person_boxes(detected));
+    stats_.tracks_started += u.started;
+    stats_.tracks_coasting += u.coasting;
+    std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
+    std::vector<people::FlowBox> refreshed;
+    for (size_t i : tracker_->refreshed()) refreshed.push_back(boxes[i]);
+    people::seed_points(gray, refreshed, flow_options_);
+    for (size_t k = 0; k < refreshed.size(); ++k) boxes[tracker_->refreshed()[k]].points = refreshed[k].points;
+    tracker_->apply_moved(boxes);
+  } else {
+    if (mode_ == DetectorMode::kLatest) people::seed_points(gray, detected, flow_options_);
+    boxes_ = std::move(detected);
+    nms_ = std::move(nms);
+  }
+}
+
+void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv::Mat& gray) {
+  fresh_ = false;
+  detection_ms_ = 0;
+  if (mode_ == DetectorMode::kEveryFrame) {
+    worker_->submit(index, colour);
+    if (tracker_) move_to(gray);  // coasting tracks follow the image
+    return;
+  }
+  move_to(gray);
+  if (auto result = worker_->poll()) take_detection(std::move(*result), gray);
+  if (worker_->offer(index, colour)) {
+    offered_gray_ = gray;
+    offered_index_ = index;
+  }
+}
+
+void PeopleStage::current_boxes(std::vector<people::PersonBox>& filter_boxes,
+                                std::vector<people::PersonBox>& area_boxes) const {
+  filter_boxes.clear();
+  area_boxes.clear();
+  if (tracker_) {
+    filter_boxes = tracker_->boxes();
+    area_boxes = filter_boxes;
+    return;
+  }
+  for (size_t i = 0; i < boxes_.size(); ++i) {
+    filter_boxes.push_back(boxes_[i].box);
+    if (nms_[i]) area_boxes.push_back(boxes_[i].box);
+  }
+}
+
+PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images, tracking::RawFeatures& raw,
+                                bool record_keypoints) {
+  PeopleFrame out;
+  std::vector<people::PersonBox> boxes, area_boxes;
+  if (mode_ == DetectorMode::kEveryFrame) {
+    people::WorkerResult result = worker_->wait(index);
+    out.detector_wait_ms = result.waited_ms;
+    if (tracker_) {
+      take_detection(std::move(result), current_gray_);
+      current_boxes(boxes, area_boxes);
+    } else {
+      // The paper's path, unchanged: this frame's own boxes.
+      ++stats_.detections;
+      fresh_ = true;
+      detection_frame_ = static_cast<int64_t>(index);
+      detection_ms_ = result.detections.time_ms;
+      boxes = filter_before_nms_ ? result.detections.raw : result.detections.boxes;
+      area_boxes = result.detections.boxes;
+    }
+  } else {
+    current_boxes(boxes, area_boxes);
+  }
+  out.detector_ms = detection_ms_;
+  out.detection_frame = detection_frame_;
+  out.boxes_propagated = detection_frame_ >= 0 && detection_frame_ != static_cast<int64_t>(index);
+  if (detection_frame_ == static_cast<int64_t>(index)) ++stats_.frames_detected;
+  if (out.boxes_propagated) ++stats_.frames_propagated;
+  out.person_boxes = static_cast<int>(area_boxes.size());
+  out.keypoints_before_filter = static_cast<int>(raw.keys.size());
+
+  std::vector<float> depth_m;
+  const bool rgbd = sensor_ == io::SensorKind::kRgbd && !images.depth.empty();
+  if (filter_options_.mode == people::FilterMode::kDepth && rgbd) {
+    depth_m.resize(raw.keys.size(), -1.0f);
+    for (size_t i = 0; i < raw.keys.size(); ++i) {
+      const int x = cvRound(raw.keys[i].pt.x);
+      const int y = cvRound(raw.keys[i].pt.y);
+      if (x < 0 || y < 0 || x >= images.depth.cols || y >= images.depth.rows) continue;
+      const uint16_t d = images.depth.at<uint16_t>(y, x);
+      if (d > 0) depth_m[i] = static_cast<float>(d / depth_map_factor_);
+    }
+  }
+  // Stereo: the keypoints' depths come from stereo matching, which runs before the filter; each person's
+  // depth is estimated from them through a sparse depth image.
+  cv::Mat stereo_depth;
+  const bool stereo = sensor_ == io::SensorKind::kStereo && raw.depth_m.size() == raw.keys.size();
+  if (filter_options_.mode == people::FilterMode::kDepth && stereo && !boxes.empty()) {
+    depth_m = raw.depth_m;
+    stereo_depth = sparse_depth_image(raw.keys, raw.depth_m, images.colour.size(), kSparseDepthFactor);
+  }
+  const double depth_factor = stereo ? kSparseDepthFactor : depth_map_factor_;
+  const people::FilterResult filtered = people::filter_keypoints(
+      raw.keys, boxes, filter_options_, depth_m, rgbd ? images.depth : stereo_depth, depth_factor);
+  if (filtered.removed > 0) {
+    tracking::RawFeatures kept;
+    kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));
+    kept.descriptors.create(static_cast<int>(raw.keys.size()) - filtered.removed, raw.descriptors.cols,
+                            raw.descriptors.type());
+    int row = 0;
+    for (size_t i = 0; i < raw.keys.size(); ++i) {
+      if (filtered.keep[i]) {
+        raw.descriptors.row(static_cast<int>(i)).copyTo(kept.descriptors.row(row++));
+        kept.keys.push_back(raw.keys[i]);
+        if (stereo) {
+          kept.right_u.push_back(raw.right_u[i]);
+          kept.depth_m.push_back(raw.depth_m[i]);
+        }
+      } else if (record_keypoints) {
+        out.removed_keypoints.push_back(raw.keys[i]);
+      }
+    }
+    raw = std::move(kept);
+  }
+  if (stereo && right_image_boxes_) {
+    // The boxes are the left image's, used unshifted on the right image.
+    for (size_t i = 0; i < raw.keys.size(); ++i) {
+      if (raw.right_u[i] < 0) continue;
+      const cv::Point2f right(raw.right_u[i], raw.keys[i].pt.y);
+      for (const auto& box : boxes) {
+        if (box.box.contains(right)) {
+          raw.right_u[i] = -1.0f;
+          raw.depth_m[i] = -1.0f;
+          ++out.right_keypoints_removed;
+          break;
+        }
+      }
+    }
+  }
+  // Feature number update for the next frame. The covered area always comes from NMS-level boxes: the
+  // raw boxes overlap heavily, and their summed area says nothing about how much of the image people cover.
+  budget_options_.image_width = images.colour.cols;
+  budget_options_.image_height = images.colour.rows;
+  out.people_area = people::covered_fraction(area_boxes, images.colour.cols, images.colour.rows, area_mode_);
+  next_feature_budget_ = people::feature_budget(out.people_area, budget_options_);
+  out.boxes = std::move(boxes);
+  return out;
+}
+
+}  // namespace crowdslam::system
