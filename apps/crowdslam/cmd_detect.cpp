@@ -17,10 +17,17 @@
 #include "crowdslam/people/model_paths.h"
 #include "crowdslam/people/mot_format.h"
 #include "crowdslam/people/mot_sequence.h"
+#include "crowdslam/util/error.h"
 
 namespace crowdslam::app {
 namespace {
 
+// `crowdslam detect`'s defaults without --settings: chosen for detection quality on the MOT sequences
+// (docs/DETECTION.md, scripts/eval_detectors.sh); the model's own default input is in model_zoo.cpp.
+// The SLAM filter's thresholds are the Detector.* keys of config/*.yaml, chosen for SLAM accuracy.
+constexpr const char* kDefaultModel = "yolox";
+constexpr double kDefaultConfidence = 0.3;
+constexpr double kDefaultNms = 0.45;
 constexpr int kMaxPersonClass = 9999;
 constexpr int kMaxThreads = 64;
 constexpr std::size_t kMaxFrames = 1000000000;
@@ -29,7 +36,7 @@ struct DetectArgs {
   std::string settings;
   std::string dataset;
   std::string out;
-  std::string model = "body";
+  std::string model = kDefaultModel;
   std::string input;  // --input WxH or S
   int input_size = 0;  // --input-size S (square, as before)
   std::string backend = "auto";
@@ -59,7 +66,9 @@ people::ModelFiles configure(DetectArgs& args) {
   if (given(app, "--backend")) d.backend = args.backend;
   if (given(app, "--preprocess")) d.preprocess = args.preprocess;
   if (given(app, "--resize")) d.resize = args.resize;
-  const people::DetectorSetup setup = people::detector_setup(d, given(app, "--model") ? args.model : std::string());
+  // With settings, their model unless --model is given; without, --model or its default.
+  const bool model_from_args = given(app, "--model") || args.settings.empty();
+  const people::DetectorSetup setup = people::detector_setup(d, model_from_args ? args.model : std::string());
   people::ModelFiles model = setup.model;
   people::DetectorOptions& o = args.options;
   if (!args.settings.empty()) {
@@ -200,6 +209,8 @@ void run_detect_eval(const DetectEvalArgs& args, const GlobalOptions& global) {
 
 void add_detect_command(CLI::App& app, const GlobalOptions& global) {
   auto args = std::make_shared<DetectArgs>();
+  args->options.confidence = kDefaultConfidence;
+  args->options.nms = kDefaultNms;
   CLI::App* detect = app.add_subcommand("detect", "Run the person detector over a sequence, write MOT boxes");
   args->app = detect;
   detect->add_option("--settings", args->settings, "Settings file (Detector.* keys)");
