@@ -25,6 +25,8 @@ namespace {
 // `crowdslam detect`'s defaults without --settings: chosen for detection quality on the MOT sequences
 // (docs/DETECTION.md, scripts/eval_detectors.sh); the model's own default input is in model_zoo.cpp.
 // The SLAM filter's thresholds are the Detector.* keys of config/*.yaml, chosen for SLAM accuracy.
+// YOLOX-nano COCO rather than ByteTrack-nano (as good on these sequences) because ByteTrack was trained
+// on MOT17: its figures on MOT16/17 sequences would not be a test.
 constexpr const char* kDefaultModel = "yolox";
 constexpr double kDefaultConfidence = 0.3;
 constexpr double kDefaultNms = 0.45;
@@ -228,7 +230,7 @@ void add_detect_command(CLI::App& app, const GlobalOptions& global) {
   // to make OpenCV start 100000 threads and crash at exit).
   detect->add_option("--input", args->input,
                      "Network input WIDTHxHEIGHT (e.g. 416x256) or SIZE (square); each a multiple of 32 "
-                     "(default: the settings', else the model's: body/coco 320, yolox/bytetrack 416x320)");
+                     "(default: the settings', else the model's: yolox 320x256, body/coco/bytetrack 416x320)");
   detect->add_option("--input-size", args->input_size, "Square network input (multiple of 32), as --input SIZE")
       ->check(CLI::Range(32, people::kMaxInputSide));
   detect->add_option("--backend", args->backend, "Decoder for a model given as a path: auto, darknet, yolo-onnx, yolox")

@@ -182,7 +182,7 @@ TEST(CliDetect, InputSizesBackendsAndDefaults) {
   const auto d = run_cli({"--json", "detect", "--dataset", seq, "--out", out, "--max-frames", "2"});
   ASSERT_EQ(d.exit_code, 0) << d.err;
   const auto j = nlohmann::json::parse(d.out);
-  EXPECT_EQ(j["detector"], "yolox_nano@416x320");
+  EXPECT_EQ(j["detector"], "yolox_nano@320x256");
   EXPECT_EQ(j["resize"], "letterbox");
   EXPECT_DOUBLE_EQ(j["confidence"].get<double>(), 0.3);
   EXPECT_DOUBLE_EQ(j["nms"].get<double>(), 0.45);

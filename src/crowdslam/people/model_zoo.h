@@ -4,10 +4,10 @@
 // One table used by `crowdslam run` (--detector, Detector.model_cfg) and `crowdslam detect` (--model).
 //
 // | name      | folder            | backend | preprocessing | classes | detect default input |
-// | body      | yolo-fastest-1.1  | darknet | darknet       | 1       | see model_zoo.cpp    |
-// | coco      | yolo-fastest-1.1  | darknet | darknet       | 80      |                      |
-// | yolox     | yolox-nano        | yolox   | yolox         | 80      |                      |
-// | bytetrack | bytetrack-nano    | yolox   | bytetrack     | 1       |                      |
+// | body      | yolo-fastest-1.1  | darknet | darknet       | 1       | 416x320              |
+// | coco      | yolo-fastest-1.1  | darknet | darknet       | 80      | 416x320              |
+// | yolox     | yolox-nano        | yolox   | yolox         | 80      | 320x256              |
+// | bytetrack | bytetrack-nano    | yolox   | bytetrack     | 1       | 416x320              |
 //
 // Backends (decoders, yolo_decode.h): darknet (.cfg + .weights through readNetFromDarknet), yolo-onnx
 // (decoded YOLOv5-style ONNX exports, the former best-effort ONNX path), yolox (raw YOLOX head).
