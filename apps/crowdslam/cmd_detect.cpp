@@ -11,16 +11,25 @@
 
 #include "commands.h"
 #include "crowdslam/io/settings.h"
-#include "crowdslam/people/darknet_detector.h"
 #include "crowdslam/people/detection_metrics.h"
+#include "crowdslam/people/detector_setup.h"
+#include "crowdslam/people/dnn_detector.h"
 #include "crowdslam/people/model_paths.h"
 #include "crowdslam/people/mot_format.h"
 #include "crowdslam/people/mot_sequence.h"
+#include "crowdslam/util/error.h"
 
 namespace crowdslam::app {
 namespace {
 
-constexpr int kMaxInputSize = 2048;  // as Detector.input_size in the settings
+// `crowdslam detect`'s defaults without --settings: chosen for detection quality on the MOT sequences
+// (docs/DETECTION.md, scripts/eval_detectors.sh); the model's own default input is in model_zoo.cpp.
+// The SLAM filter's thresholds are the Detector.* keys of config/*.yaml, chosen for SLAM accuracy.
+// YOLOX-nano COCO rather than ByteTrack-nano (as good on these sequences) because ByteTrack was trained
+// on MOT17: its figures on MOT16/17 sequences would not be a test.
+constexpr const char* kDefaultModel = "yolox";
+constexpr double kDefaultConfidence = 0.3;
+constexpr double kDefaultNms = 0.45;
 constexpr int kMaxPersonClass = 9999;
 constexpr int kMaxThreads = 64;
 constexpr std::size_t kMaxFrames = 1000000000;
@@ -29,7 +38,12 @@ struct DetectArgs {
   std::string settings;
   std::string dataset;
   std::string out;
-  std::string model = "body";
+  std::string model = kDefaultModel;
+  std::string input;  // --input WxH or S
+  int input_size = 0;  // --input-size S (square, as before)
+  std::string backend = "auto";
+  std::string preprocess = "auto";
+  std::string resize = "auto";
   people::DetectorOptions options;
   bool raw = false;
   std::size_t max_frames = 0;
@@ -44,21 +58,47 @@ struct DetectEvalArgs {
 
 bool given(const CLI::App& app, const std::string& option) { return app.count(option) > 0; }
 
-// Settings first (Detector.* keys), then the command-line options that were given explicitly.
+// Settings first (Detector.* keys, people/detector_setup.h), then the command-line options that were
+// given explicitly. Without settings, the input is the model's detect default (model_zoo.cpp) and the
+// thresholds those of DetectorOptions as set up in add_detect_command.
 people::ModelFiles configure(DetectArgs& args) {
-  people::ModelFiles model = people::resolve_model(args.model);
+  const CLI::App& app = *args.app;
+  io::DetectorSettings d;
+  if (!args.settings.empty()) d = io::load_settings(args.settings, io::SensorKind::kMonocular).detector;
+  if (given(app, "--backend")) d.backend = args.backend;
+  if (given(app, "--preprocess")) d.preprocess = args.preprocess;
+  if (given(app, "--resize")) d.resize = args.resize;
+  // With settings, their model unless --model is given; without, --model or its default.
+  const bool model_from_args = given(app, "--model") || args.settings.empty();
+  const people::DetectorSetup setup = people::detector_setup(d, model_from_args ? args.model : std::string());
+  people::ModelFiles model = setup.model;
+  people::DetectorOptions& o = args.options;
   if (!args.settings.empty()) {
-    const io::DetectorSettings d = io::load_settings(args.settings, io::SensorKind::kMonocular).detector;
-    const CLI::App& app = *args.app;
-    if (!given(app, "--input-size")) args.options.input_size = d.input_size;
-    if (!given(app, "--confidence")) args.options.confidence = d.confidence;
-    if (!given(app, "--nms")) args.options.nms = d.nms;
-    if (!given(app, "--person-class")) args.options.person_class = d.person_class;
+    o.input_size = setup.options.input_size;
+    o.input_width = setup.options.input_width;
+    o.input_height = setup.options.input_height;
+    if (!given(app, "--confidence")) o.confidence = setup.options.confidence;
+    if (!given(app, "--nms")) o.nms = setup.options.nms;
     if (!given(app, "--raw")) args.raw = d.filter_before_nms;
-    if (!given(app, "--model") && !d.model_cfg.empty())
-      model = {d.model_cfg, d.model_weights, d.person_class};
+  } else if (model.detect_input.width > 0) {
+    o.input_width = model.detect_input.width;
+    o.input_height = model.detect_input.height;
   }
-  args.options.check();
+  o.resize = setup.options.resize;
+  if (given(app, "--input") && given(app, "--input-size"))
+    throw InputError("--input and --input-size: give one of them (--input-size S is --input S)");
+  if (given(app, "--input")) {
+    const cv::Size size = people::parse_input_size(args.input, "--input");
+    o.input_width = size.width;
+    o.input_height = size.height;
+  }
+  if (given(app, "--input-size")) {
+    o.input_size = args.input_size;
+    o.input_width = o.input_height = 0;
+  }
+  model.person_class = given(app, "--person-class") ? o.person_class : setup.options.person_class;
+  o.person_class = model.person_class;
+  o.check();
   return model;
 }
 
@@ -72,7 +112,7 @@ double median(std::vector<double> values) {
 void run_detect(DetectArgs& args, const GlobalOptions& global) {
   const people::ModelFiles model = configure(args);
   auto source = people::open_detection_source(args.dataset);
-  people::DarknetDetector detector(model, args.options);
+  people::DnnDetector detector(model, args.options);
   std::vector<people::FrameBoxes> frames;
   std::vector<double> times_ms;
   std::size_t boxes = 0;
@@ -94,6 +134,11 @@ void run_detect(DetectArgs& args, const GlobalOptions& global) {
                 {"detector", detector.name()},
                 {"model_config", model.config},
                 {"input_size", args.options.input_size},
+                {"input_width", args.options.input().width},
+                {"input_height", args.options.input().height},
+                {"backend", people::to_string(detector.backend())},
+                {"preprocess", detector.preprocessing().name},
+                {"resize", people::to_string(detector.preprocessing().resize)},
                 {"confidence", args.options.confidence},
                 {"nms", args.options.nms},
                 {"before_nms", args.raw},
@@ -103,7 +148,9 @@ void run_detect(DetectArgs& args, const GlobalOptions& global) {
                 {"median_time_ms", median(times_ms)}});
     return;
   }
-  std::printf("detector   %s (%s)\n", detector.name().c_str(), args.raw ? "boxes before NMS" : "after NMS");
+  std::printf("detector   %s (%s, %s, %s; %s)\n", detector.name().c_str(), people::to_string(detector.backend()),
+              detector.preprocessing().name.c_str(), people::to_string(detector.preprocessing().resize),
+              args.raw ? "boxes before NMS" : "after NMS");
   std::printf("frames     %zu\n", frames.size());
   std::printf("boxes      %zu\n", boxes);
   std::printf("time_ms    mean %.3f median %.3f\n", mean_ms, median(times_ms));
@@ -164,6 +211,8 @@ void run_detect_eval(const DetectEvalArgs& args, const GlobalOptions& global) {
 
 void add_detect_command(CLI::App& app, const GlobalOptions& global) {
   auto args = std::make_shared<DetectArgs>();
+  args->options.confidence = kDefaultConfidence;
+  args->options.nms = kDefaultNms;
   CLI::App* detect = app.add_subcommand("detect", "Run the person detector over a sequence, write MOT boxes");
   args->app = detect;
   detect->add_option("--settings", args->settings, "Settings file (Detector.* keys)");
@@ -174,13 +223,22 @@ void add_detect_command(CLI::App& app, const GlobalOptions& global) {
   detect->add_option("--out", args->out, "Output detections, MOT format frame,-1,x,y,w,h,conf,-1,-1,-1")
       ->required();
   detect
-      ->add_option("--model", args->model, "body, coco, a Darknet .cfg (.weights beside it) or an .onnx file")
+      ->add_option("--model,--detector", args->model,
+                   people::zoo_model_names() + ", a Darknet .cfg (.weights beside it) or an .onnx file")
       ->capture_default_str();
   // Every numeric option is bounded here, so a bad value is a clear CLI error (e.g. --threads 100000 used
   // to make OpenCV start 100000 threads and crash at exit).
-  detect->add_option("--input-size", args->options.input_size, "Network input size (multiple of 32)")
-      ->capture_default_str()
-      ->check(CLI::Range(32, kMaxInputSize));
+  detect->add_option("--input", args->input,
+                     "Network input WIDTHxHEIGHT (e.g. 416x256) or SIZE (square); each a multiple of 32 "
+                     "(default: the settings', else the model's: yolox 320x256, body/coco/bytetrack 416x320)");
+  detect->add_option("--input-size", args->input_size, "Square network input (multiple of 32), as --input SIZE")
+      ->check(CLI::Range(32, people::kMaxInputSide));
+  detect->add_option("--backend", args->backend, "Decoder for a model given as a path: auto, darknet, yolo-onnx, yolox")
+      ->check(CLI::IsMember({"auto", "darknet", "yolo-onnx", "yolox"}));
+  detect->add_option("--preprocess", args->preprocess, "Preprocessing: auto (the model's), darknet, yolox, bytetrack")
+      ->check(CLI::IsMember({"auto", "darknet", "yolox", "bytetrack"}));
+  detect->add_option("--resize", args->resize, "Resize: auto (the preprocessing's), stretch, letterbox")
+      ->check(CLI::IsMember({"auto", "stretch", "letterbox"}));
   detect->add_option("--confidence", args->options.confidence, "Confidence threshold")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));

@@ -67,7 +67,9 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                 "Run without the people filter and without the feature-number update (static-world baseline)");
   cmd->add_option("--detections", args->options.detections_file,
                   "Person boxes from a MOT-format file (frame,id,x,y,w,h,conf,...) instead of the detector");
-  cmd->add_option("--detector", args->options.detector_model, "Detector model: body, coco, PATH.cfg or PATH.onnx");
+  cmd->add_option("--detector", args->options.detector_model,
+                  "Detector model: body, coco, yolox, bytetrack, PATH.cfg or PATH.onnx (input, backend and "
+                  "preprocessing from the Detector.* settings; docs/DETECTION.md)");
   cmd->add_option("--filter-mode", args->options.filter_mode, "People filter mode: paper or depth");
   cmd->add_option("--detector-mode", args->options.detector_mode,
                   "every_frame: each frame waits for its own boxes; latest: the detector takes the newest frame "

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "crowdslam/util/text.h"
 #include "test_support.h"
@@ -106,7 +107,11 @@ TEST(CliDetect, MotSequenceRoundTripThroughDetectEval) {
   TempDir dir;
   const fs::path seq = crowdslam::test::shared_data("mot") / "TUD-Campus";
   const std::string out = (dir / "det.txt").string();
-  const auto r = run_cli({"--json", "detect", "--dataset", seq.string(), "--out", out});
+  // The paper's setting (body @ 160, 0.2 / 0.1), which the SLAM default uses.
+  const std::vector<std::string> paper = {"--model", "body", "--input", "160", "--confidence", "0.2", "--nms", "0.1"};
+  std::vector<std::string> args = {"--json", "detect", "--dataset", seq.string(), "--out", out};
+  args.insert(args.end(), paper.begin(), paper.end());
+  const auto r = run_cli(args);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["frames"], 71);
@@ -134,9 +139,69 @@ TEST(CliDetect, MotSequenceRoundTripThroughDetectEval) {
   EXPECT_GT(m["precision"].get<double>(), 0.7);
   // Before NMS there are at least as many boxes.
   const std::string raw = (dir / "raw.txt").string();
-  const auto rr = run_cli({"--json", "detect", "--dataset", seq.string(), "--out", raw, "--raw"});
+  std::vector<std::string> raw_args = {"--json", "detect", "--dataset", seq.string(), "--out", raw, "--raw"};
+  raw_args.insert(raw_args.end(), paper.begin(), paper.end());
+  const auto rr = run_cli(raw_args);
   ASSERT_EQ(rr.exit_code, 0) << rr.err;
   EXPECT_GE(nlohmann::json::parse(rr.out)["boxes"].get<std::size_t>(), rows);
+}
+
+// --input W x H and the per-model defaults: what was used is in the JSON; bad sizes and conflicting options
+// fail before any output.
+TEST(CliDetect, InputSizesBackendsAndDefaults) {
+  CROWDSLAM_REQUIRE_SHARED("mot");
+  TempDir dir;
+  const std::string seq = (crowdslam::test::shared_data("mot") / "TUD-Stadtmitte").string();
+  const std::string out = (dir / "det.txt").string();
+  for (const char* bad : {"416x250", "0x256", "wide"}) {
+    const auto r = run_cli({"detect", "--dataset", seq, "--out", out, "--model", "body", "--input", bad});
+    EXPECT_EQ(r.exit_code, 1) << bad;
+    EXPECT_NE(r.err.find("--input"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  }
+  const auto both = run_cli({"detect", "--dataset", seq, "--out", out, "--input", "320", "--input-size", "320"});
+  EXPECT_EQ(both.exit_code, 1);
+  EXPECT_NE(both.err.find("--input-size"), std::string::npos) << both.err;
+  const auto unknown = run_cli({"detect", "--dataset", seq, "--out", out, "--model", "yolov8"});
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_NE(unknown.err.find("yolov8"), std::string::npos) << unknown.err;
+  EXPECT_FALSE(fs::exists(out));
+  if (!models_available()) GTEST_SKIP() << "shared models missing";
+  const auto body = run_cli({"--json", "detect", "--dataset", seq, "--out", out, "--model", "body", "--input",
+                             "320x256", "--resize", "letterbox", "--max-frames", "2"});
+  ASSERT_EQ(body.exit_code, 0) << body.err;
+  const auto b = nlohmann::json::parse(body.out);
+  EXPECT_EQ(b["input_width"], 320);
+  EXPECT_EQ(b["input_height"], 256);
+  EXPECT_EQ(b["backend"], "darknet");
+  EXPECT_EQ(b["resize"], "letterbox");
+  EXPECT_EQ(b["detector"], "yolo-fastest-1.1_body@320x256");
+  const fs::path yolox = crowdslam::test::shared_dir() / "models" / "yolox-nano" / "yolox_nano.onnx";
+  if (!fs::exists(yolox)) GTEST_SKIP() << "YOLOX model missing: " << yolox;
+  // Without --settings and --input: the default model with its own default input and thresholds.
+  const auto d = run_cli({"--json", "detect", "--dataset", seq, "--out", out, "--max-frames", "2"});
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  const auto j = nlohmann::json::parse(d.out);
+  EXPECT_EQ(j["detector"], "yolox_nano@320x256");
+  EXPECT_EQ(j["resize"], "letterbox");
+  EXPECT_DOUBLE_EQ(j["confidence"].get<double>(), 0.3);
+  EXPECT_DOUBLE_EQ(j["nms"].get<double>(), 0.45);
+  EXPECT_GE(j["boxes"].get<int>(), 8);  // 7 annotated people a frame
+  // A YOLOX .onnx given as a path needs --backend yolox; as yolo-onnx it runs (same row width) but
+  // decodes the raw head as if it were decoded, which the layout cannot tell: the backend is declared.
+  const auto path = run_cli({"--json", "detect", "--dataset", seq, "--out", out, "--model", yolox.string(),
+                             "--backend", "yolox", "--preprocess", "yolox", "--input", "416x320", "--max-frames", "1"});
+  ASSERT_EQ(path.exit_code, 0) << path.err;
+  EXPECT_EQ(nlohmann::json::parse(path.out)["backend"], "yolox");
+  // With --settings, the SLAM detector: body @ 160 (stretch), 0.2 / 0.1, boxes before NMS.
+  const auto slam = run_cli({"--json", "detect", "--settings", (crowdslam::test::source_dir() / "config" / "Bonn.yaml").string(),
+                             "--dataset", seq, "--out", out, "--max-frames", "1"});
+  ASSERT_EQ(slam.exit_code, 0) << slam.err;
+  const auto sj = nlohmann::json::parse(slam.out);
+  EXPECT_EQ(sj["detector"], "yolo-fastest-1.1_body@160");
+  EXPECT_EQ(sj["resize"], "stretch");
+  EXPECT_DOUBLE_EQ(sj["nms"].get<double>(), 0.1);
+  EXPECT_EQ(sj["before_nms"], true);
 }
 
 }  // namespace

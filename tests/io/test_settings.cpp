@@ -130,6 +130,11 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.detector.model_cfg = "models/yolo \"fastest\".cfg";
   s.detector.confidence = 1.0 / 3.0;
   s.detector.filter_before_nms = false;
+  s.detector.input_width = 416;
+  s.detector.input_height = 256;
+  s.detector.backend = "yolox";
+  s.detector.preprocess = "bytetrack";
+  s.detector.resize = "letterbox";
   s.people_filter.mode = "paper";
   s.feature_budget.thresholds = {0.0, 0.5};
   s.feature_budget.factors = {1.0, 1.25, 3.0};
@@ -140,6 +145,8 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   const Settings back = load_settings(path, SensorKind::kStereo);
   EXPECT_TRUE(back == s);
   EXPECT_EQ(back.detector.model_cfg, "models/yolo \"fastest\".cfg");
+  EXPECT_EQ(back.detector.input_width, 416);
+  EXPECT_EQ(back.detector.resize, "letterbox");
   EXPECT_EQ(back.camera.k1, 0.1 + 0.2);
   // A monocular settings object without rectification also survives.
   Settings mono = load_settings(config("TUM3.yaml"), SensorKind::kMonocular);
@@ -154,6 +161,11 @@ TEST(Settings, OwnSectionsTakeDefaultsWhenAbsent) {
   write_text(dir / "s.yaml", text);
   const Settings s = load_settings((dir / "s.yaml").string(), SensorKind::kRgbd);
   EXPECT_EQ(s.detector.input_size, 160);
+  EXPECT_EQ(s.detector.input_width, 0);  // 0 x 0 = the square input_size
+  EXPECT_EQ(s.detector.input_height, 0);
+  EXPECT_EQ(s.detector.backend, "auto");
+  EXPECT_EQ(s.detector.preprocess, "auto");
+  EXPECT_EQ(s.detector.resize, "auto");
   EXPECT_DOUBLE_EQ(s.detector.confidence, 0.2);
   EXPECT_DOUBLE_EQ(s.detector.nms, 0.1);
   EXPECT_TRUE(s.people_filter.enabled);
@@ -244,6 +256,18 @@ INSTANTIATE_TEST_SUITE_P(
                  "ORBextractor.minThFAST: must be > 0"},
         BadValue{"Detector.input_size", "Detector.input_size: 100",
                  "Detector.input_size: must be a positive multiple of 32"},
+        BadValue{"Detector.input_size", "Detector.input_size: 160\nDetector.input_width: 100\nDetector.input_height: 256",
+                 "Detector.input_width: must be 0 or a positive multiple of 32, got 100"},
+        BadValue{"Detector.input_size", "Detector.input_size: 160\nDetector.input_width: 416\nDetector.input_height: 4096",
+                 "Detector.input_height: must be <= 2048"},
+        BadValue{"Detector.input_size", "Detector.input_size: 160\nDetector.input_width: 416",
+                 "Detector.input_height: must be set together with Detector.input_width"},
+        BadValue{"Detector.input_size", "Detector.input_size: 160\nDetector.backend: \"yolov8\"",
+                 "Detector.backend: must be \"auto\", \"darknet\", \"yolo-onnx\" or \"yolox\", got \"yolov8\""},
+        BadValue{"Detector.input_size", "Detector.input_size: 160\nDetector.preprocess: \"imagenet\"",
+                 "Detector.preprocess: must be \"auto\", \"darknet\", \"yolox\" or \"bytetrack\""},
+        BadValue{"Detector.input_size", "Detector.input_size: 160\nDetector.resize: \"crop\"",
+                 "Detector.resize: must be \"auto\", \"stretch\" or \"letterbox\""},
         BadValue{"Detector.confidence", "Detector.confidence: 1.5", "Detector.confidence: must be in (0, 1]"},
         BadValue{"Detector.nms", "Detector.nms: 0", "Detector.nms: must be in (0, 1]"},
         BadValue{"Detector.person_class", "Detector.person_class: -1", "Detector.person_class: must be >= 0"},

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 
 #include "crowdslam/people/darknet_detector.h"
@@ -16,13 +17,18 @@ namespace fs = std::filesystem;
 
 fs::path model_dir() { return test::shared_dir() / "models" / "yolo-fastest-1.1"; }
 
+ModelFiles files(const std::string& config, const std::string& weights) {
+  ModelFiles m;
+  m.config = config;
+  m.weights = weights;
+  return m;
+}
 ModelFiles body_model() {
-  return {(model_dir() / "yolo-fastest-1.1_body.cfg").string(),
-          (model_dir() / "yolo-fastest-1.1_body.weights").string(), 0};
+  return files((model_dir() / "yolo-fastest-1.1_body.cfg").string(),
+               (model_dir() / "yolo-fastest-1.1_body.weights").string());
 }
 ModelFiles coco_model() {
-  return {(model_dir() / "yolo-fastest-1.1.cfg").string(),
-          (model_dir() / "yolo-fastest-1.1.weights").string(), 0};
+  return files((model_dir() / "yolo-fastest-1.1.cfg").string(), (model_dir() / "yolo-fastest-1.1.weights").string());
 }
 
 #define REQUIRE_MODELS()                                                                    \
@@ -42,10 +48,10 @@ std::string load_error(const ModelFiles& model) {
 TEST(DarknetDetector, MissingModelNamesTheFile) {
   test::TempDir dir;
   const std::string cfg = (dir / "nothing.cfg").string();
-  EXPECT_NE(load_error({cfg, (dir / "nothing.weights").string(), 0}).find("nothing.cfg"), std::string::npos);
+  EXPECT_NE(load_error(files(cfg, (dir / "nothing.weights").string())).find("nothing.cfg"), std::string::npos);
   test::write_text(dir / "only.cfg", "[net]\n");
   EXPECT_NE(
-      load_error({(dir / "only.cfg").string(), (dir / "only.weights").string(), 0}).find("only.weights"),
+      load_error(files((dir / "only.cfg").string(), (dir / "only.weights").string())).find("only.weights"),
       std::string::npos);
 }
 
@@ -54,25 +60,25 @@ TEST(DarknetDetector, CorruptModelIsOneInputErrorNamingTheFile) {
   test::TempDir dir;
   // A cfg that is not a network, with real weights.
   test::write_text(dir / "garbage.cfg", "this is not a darknet cfg\n[convolutional]\nfilters=abc\n");
-  const std::string garbage = load_error({(dir / "garbage.cfg").string(), body_model().weights, 0});
+  const std::string garbage = load_error(files((dir / "garbage.cfg").string(), body_model().weights));
   EXPECT_NE(garbage.find("garbage.cfg"), std::string::npos) << garbage;
   // Real cfg, truncated weights.
   const std::string weights = (dir / "cut.weights").string();
   fs::copy_file(body_model().weights, weights);
   fs::resize_file(weights, fs::file_size(weights) / 3);
-  const std::string cut = load_error({body_model().config, weights, 0});
+  const std::string cut = load_error(files(body_model().config, weights));
   EXPECT_NE(cut.find("cut.weights"), std::string::npos) << cut;
   // Empty weights.
   test::write_text(dir / "empty.weights", "");
-  const std::string empty = load_error({body_model().config, (dir / "empty.weights").string(), 0});
+  const std::string empty = load_error(files(body_model().config, (dir / "empty.weights").string()));
   EXPECT_NE(empty.find("empty.weights"), std::string::npos) << empty;
 }
 
 TEST(DarknetDetector, OnnxErrorsNameTheFile) {
   test::TempDir dir;
-  EXPECT_NE(load_error({(dir / "yolo.onnx").string(), {}, 0}).find("yolo.onnx"), std::string::npos);
+  EXPECT_NE(load_error(files((dir / "yolo.onnx").string(), "")).find("yolo.onnx"), std::string::npos);
   test::write_text(dir / "bad.onnx", "not a protobuf at all");
-  const std::string bad = load_error({(dir / "bad.onnx").string(), {}, 0});
+  const std::string bad = load_error(files((dir / "bad.onnx").string(), ""));
   EXPECT_NE(bad.find("bad.onnx"), std::string::npos) << bad;
 }
 
@@ -80,14 +86,10 @@ TEST(DarknetDetector, PersonClassOutOfRangeIsAnError) {
   REQUIRE_MODELS();
   DetectorOptions options;
   options.person_class = 3;  // the body model has one class
-  DarknetDetector d(body_model(), options);
-  const cv::Mat image(240, 320, CV_8UC3, cv::Scalar::all(100));
-  try {
-    d.detect(image, 0);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("yolo-fastest-1.1_body.cfg"), std::string::npos) << e.what();
-  }
+  // Found by the warm-up forward pass in the constructor, before the first frame.
+  const std::string message = test::error_of([&] { DarknetDetector d(body_model(), options); });
+  EXPECT_NE(message.find("yolo-fastest-1.1_body.cfg"), std::string::npos) << message;
+  EXPECT_NE(message.find("person class 3"), std::string::npos) << message;
 }
 
 // OpenCV's region layer multiplies objectness into the class scores: no class score exceeds its row's
@@ -162,6 +164,36 @@ TEST(DarknetDetector, ConfidenceBelowPointTwoTakesEffect) {
     if (b.confidence < 0.2f) ++below;
   }
   EXPECT_GT(below, 0);
+}
+
+// Aspect-true inputs for the Darknet backend: a non-square stretch (320 x 256 for a 4:3 frame) and the
+// letterbox both find the annotated people, with boxes mapped back into the 640 x 480 image.
+TEST(DarknetDetector, NonSquareAndLetterboxInputs) {
+  REQUIRE_MODELS();
+  CROWDSLAM_REQUIRE_SHARED("mot");
+  const fs::path seq = test::shared_data("mot") / "TUD-Stadtmitte";
+  const cv::Mat image = cv::imread((seq / "img1" / "000001.jpg").string());
+  std::vector<cv::Rect2f> gt;
+  for (const MotRow& row : read_mot_file((seq / "gt" / "gt.txt").string(), true).rows)
+    if (row.frame == 1 && row.score != 0) gt.push_back(row.box);
+  for (const std::optional<ResizeMode> resize : {std::optional<ResizeMode>(), std::optional(ResizeMode::kLetterbox)}) {
+    DetectorOptions options;
+    options.input_width = 320;
+    options.input_height = 256;
+    options.resize = resize;
+    DarknetDetector d(body_model(), options);
+    EXPECT_EQ(d.name(), "yolo-fastest-1.1_body@320x256");
+    EXPECT_EQ(d.preprocessing().resize, resize.value_or(ResizeMode::kStretch));
+    std::vector<cv::Rect2f> found;
+    for (const PersonBox& b : d.detect(image, 0).boxes) {
+      EXPECT_LE(b.box.y + b.box.height, image.rows + 1e-3);
+      found.push_back(b.box);
+    }
+    DetectionCounts counts;
+    evaluate_frame(gt, {}, found, 0.5, counts);
+    EXPECT_GE(counts.recall(), 0.5) << to_string(d.preprocessing().resize) << ": TP " << counts.true_positives
+                                    << " of " << gt.size();
+  }
 }
 
 }  // namespace

@@ -68,6 +68,11 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.text("Detector.model_cfg"), s.detector.model_cfg);
   set_if(r.text("Detector.model_weights"), s.detector.model_weights);
   set_if(r.integer("Detector.input_size"), s.detector.input_size);
+  set_if(r.integer("Detector.input_width"), s.detector.input_width);
+  set_if(r.integer("Detector.input_height"), s.detector.input_height);
+  set_if(r.text("Detector.backend"), s.detector.backend);
+  set_if(r.text("Detector.preprocess"), s.detector.preprocess);
+  set_if(r.text("Detector.resize"), s.detector.resize);
   set_if(r.real("Detector.confidence"), s.detector.confidence);
   set_if(r.real("Detector.nms"), s.detector.nms);
   set_if(r.integer("Detector.person_class"), s.detector.person_class);
@@ -154,7 +159,10 @@ bool operator==(const Settings& a, const Settings& b) {
   const auto& da = a.detector;
   const auto& db = b.detector;
   const bool detector = da.model_cfg == db.model_cfg && da.model_weights == db.model_weights &&
-                        da.input_size == db.input_size && da.confidence == db.confidence &&
+                        da.input_size == db.input_size && da.input_width == db.input_width &&
+                        da.input_height == db.input_height && da.backend == db.backend &&
+                        da.preprocess == db.preprocess && da.resize == db.resize &&
+                        da.confidence == db.confidence &&
                         da.nms == db.nms && da.person_class == db.person_class &&
                         da.filter_before_nms == db.filter_before_nms;
   const bool people = a.people_filter.enabled == b.people_filter.enabled &&

@@ -59,9 +59,14 @@ struct StereoRectification {
 };
 
 struct DetectorSettings {
-  std::string model_cfg;      // Darknet .cfg (empty = not configured)
+  std::string model_cfg;      // model name (body, coco, yolox, bytetrack), Darknet .cfg or .onnx (empty = body)
   std::string model_weights;  // Darknet .weights
-  int input_size = 160;       // network input (square), multiple of 32
+  int input_size = 160;       // square network input, multiple of 32 (shorthand for width = height)
+  int input_width = 0;        // with input_height: a non-square input, e.g. 416 x 256 (0 = input_size)
+  int input_height = 0;
+  std::string backend = "auto";     // auto | darknet | yolo-onnx | yolox (auto: the model's, else by extension)
+  std::string preprocess = "auto";  // auto | darknet | yolox | bytetrack (auto: the model's / backend's)
+  std::string resize = "auto";      // auto | stretch | letterbox (auto: the preprocessing's)
   double confidence = 0.2;
   double nms = 0.1;
   int person_class = 0;

@@ -1,5 +1,8 @@
 // Settings::check: every value validated, errors name the file and the key.
 #include <cmath>
+#include <initializer_list>
+#include <string>
+#include <utility>
 #include <sstream>
 
 #include "crowdslam/io/input_text.h"
@@ -134,11 +137,35 @@ void check_rectification(const Checker& c, const StereoRectification& r, const C
   if (cam.bf > 0) c.close(cam.bf, -r.right.P.at<double>(0, 3), "Camera.bf", "-RIGHT.P(0,3)");
 }
 
-void check_own_sections(const Checker& c, const Settings& s) {
-  const auto& d = s.detector;
+bool one_of(const std::string& value, std::initializer_list<const char*> allowed) {
+  for (const char* a : allowed)
+    if (value == a) return true;
+  return false;
+}
+
+std::string quoted_value(const std::string& value) { return "\"" + value + "\""; }
+
+void check_detector(const Checker& c, const DetectorSettings& d) {
   c.require(d.input_size > 0 && d.input_size % 32 == 0, "Detector.input_size", "a positive multiple of 32",
             d.input_size);
   c.require(d.input_size <= kMaxDetectorInput, "Detector.input_size", "<= 2048", d.input_size);
+  // input_width / input_height: both or neither (0 = the square input_size).
+  for (const auto& [key, value] : {std::pair{"Detector.input_width", d.input_width},
+                                   std::pair{"Detector.input_height", d.input_height}}) {
+    c.require(value == 0 || (value > 0 && value % 32 == 0), key, "0 or a positive multiple of 32", value);
+    c.require(value <= kMaxDetectorInput, key, "<= 2048", value);
+  }
+  if ((d.input_width == 0) != (d.input_height == 0))
+    c.fail(d.input_width == 0 ? "Detector.input_width" : "Detector.input_height",
+           "must be set together with " +
+               std::string(d.input_width == 0 ? "Detector.input_height" : "Detector.input_width") +
+               " (or leave both unset and use Detector.input_size)");
+  c.require(one_of(d.backend, {"auto", "darknet", "yolo-onnx", "yolox"}), "Detector.backend",
+            "\"auto\", \"darknet\", \"yolo-onnx\" or \"yolox\"", quoted_value(d.backend));
+  c.require(one_of(d.preprocess, {"auto", "darknet", "yolox", "bytetrack"}), "Detector.preprocess",
+            "\"auto\", \"darknet\", \"yolox\" or \"bytetrack\"", quoted_value(d.preprocess));
+  c.require(one_of(d.resize, {"auto", "stretch", "letterbox"}), "Detector.resize",
+            "\"auto\", \"stretch\" or \"letterbox\"", quoted_value(d.resize));
   c.require(std::isfinite(d.confidence) && d.confidence > 0 && d.confidence <= 1, "Detector.confidence",
             "in (0, 1]", d.confidence);
   c.require(std::isfinite(d.nms) && d.nms > 0 && d.nms <= 1, "Detector.nms", "in (0, 1]", d.nms);
@@ -152,6 +179,10 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(d.track_confirm_confidence) && d.track_confirm_confidence >= 0 &&
                 d.track_confirm_confidence <= 1,
             "Detector.track_confirm_confidence", "in [0, 1]", d.track_confirm_confidence);
+}
+
+void check_own_sections(const Checker& c, const Settings& s) {
+  check_detector(c, s.detector);
   const auto& p = s.people_filter;
   c.require(p.mode == "paper" || p.mode == "depth", "PeopleFilter.mode", "\"paper\" or \"depth\"",
             "\"" + p.mode + "\"");

@@ -83,9 +83,16 @@ void write_orb(std::ostream& out, const OrbSettings& o) {
 
 void write_own_sections(std::ostream& out, const Settings& s) {
   const auto& d = s.detector;
-  out << "# Person detector (Darknet model through OpenCV DNN)\n";
+  out << "# Person detector (OpenCV DNN; docs/DETECTION.md)\n";
   out << "Detector.model_cfg: " << quoted(d.model_cfg)
-      << "\nDetector.model_weights: " << quoted(d.model_weights) << "\nDetector.input_size: " << d.input_size
+      << "\nDetector.model_weights: " << quoted(d.model_weights) << "\nDetector.input_size: " << d.input_size;
+  // Written only when set, so files written for a square input read the same in older versions.
+  if (d.input_width > 0 || d.input_height > 0)
+    out << "\nDetector.input_width: " << d.input_width << "\nDetector.input_height: " << d.input_height;
+  if (d.backend != "auto") out << "\nDetector.backend: " << quoted(d.backend);
+  if (d.preprocess != "auto") out << "\nDetector.preprocess: " << quoted(d.preprocess);
+  if (d.resize != "auto") out << "\nDetector.resize: " << quoted(d.resize);
+  out
       << "\nDetector.confidence: " << real_text(d.confidence) << "\nDetector.nms: " << real_text(d.nms)
       << "\nDetector.person_class: " << d.person_class
       << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0) << "\nDetector.mode: " << quoted(d.mode)

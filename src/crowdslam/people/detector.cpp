@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/dnn.hpp>
 #include <sstream>
+#include <string>
 
 #include "crowdslam/util/error.h"
 
@@ -18,15 +19,56 @@ void require(bool ok, const char* key, const char* expected, T value) {
   throw InputError(message.str());
 }
 
+bool valid_side(int side) { return side >= 32 && side <= kMaxInputSide && side % 32 == 0; }
+
 }  // namespace
+
+cv::Size DetectorOptions::input() const {
+  if (input_width > 0 && input_height > 0) return {input_width, input_height};
+  return {input_size, input_size};
+}
 
 void DetectorOptions::check() const {
   require(input_size >= 32 && input_size % 32 == 0, "input_size", "a multiple of 32 and >= 32", input_size);
+  require(input_size <= kMaxInputSide, "input_size", "<= 2048", input_size);
+  require((input_width == 0) == (input_height == 0), "input_width / input_height",
+          "both set or both 0", std::to_string(input_width) + " / " + std::to_string(input_height));
+  if (input_width != 0) {
+    require(valid_side(input_width), "input_width", "a multiple of 32 in 32..2048", input_width);
+    require(valid_side(input_height), "input_height", "a multiple of 32 in 32..2048", input_height);
+  }
   require(std::isfinite(confidence) && confidence >= 0 && confidence <= 1, "confidence", "in [0, 1]",
           confidence);
   require(std::isfinite(nms) && nms >= 0 && nms <= 1, "nms", "in [0, 1]", nms);
   require(person_class >= 0, "person_class", ">= 0", person_class);
   require(opencv_threads >= 0, "opencv_threads", ">= 0", opencv_threads);
+}
+
+cv::Size parse_input_size(const std::string& text, const std::string& key) {
+  const std::size_t x = text.find('x');
+  const auto side = [&](const std::string& part) {
+    std::size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (part.empty() || used != part.size() || !valid_side(value))
+      throw InputError(key + ": expected WIDTHxHEIGHT or one SIZE, each a multiple of 32 in 32..2048, got \"" +
+                       text + "\"");
+    return value;
+  };
+  if (x == std::string::npos) {
+    const int s = side(text);
+    return {s, s};
+  }
+  return {side(text.substr(0, x)), side(text.substr(x + 1))};
+}
+
+std::string input_size_text(cv::Size size) {
+  if (size.width == size.height) return std::to_string(size.width);
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
 cv::Rect2f clip_box(const cv::Rect2f& box, int width, int height) {

@@ -2,16 +2,20 @@
 // Person detectors: the interface the SLAM system and the `crowdslam detect` tool use, and the options
 // shared by every backend.
 //
-// Backends: DarknetDetector (OpenCV DNN, Darknet .cfg/.weights or a YOLO .onnx export; darknet_detector.h)
-// and MotFileDetector (boxes read from a MOT-format file; mot_file_detector.h).
+// Backends: DnnDetector (OpenCV DNN: Darknet .cfg/.weights, YOLOX and YOLOv5-style .onnx exports;
+// dnn_detector.h, formerly DarknetDetector) and MotFileDetector (boxes read from a MOT-format file;
+// mot_file_detector.h).
 //
 // Boxes are in pixels of the image given to detect(): x, y = top-left corner, clipped to the image.
 // `raw` keeps every box above the confidence threshold before non-maximum suppression (the original
 // Crowd-SLAM masked with those), `boxes` the ones NMS kept.
 #include <cstddef>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "crowdslam/people/preprocess.h"
 
 namespace crowdslam::people {
 
@@ -27,7 +31,15 @@ struct Detections {
 };
 
 struct DetectorOptions {
-  int input_size = 160;     // square network input, multiple of 32 and >= 32
+  // Network input: input_width x input_height when both are set (> 0), else input_size x input_size
+  // (the square shorthand of older settings files). Each a multiple of 32, in 32..kMaxInputSide.
+  int input_size = 160;
+  int input_width = 0;
+  int input_height = 0;
+  // How the image becomes the input; unset = the model's preprocessing (stretch for Darknet, letterbox
+  // for YOLOX). Letterbox keeps the aspect for any input size; stretch is aspect-true when the input
+  // has the image's aspect.
+  std::optional<ResizeMode> resize;
   double confidence = 0.2;  // boxes with a person score below this are dropped
   double nms = 0.1;         // IoU threshold of non-maximum suppression
   int person_class = 0;     // class index of "person" in the model's output
@@ -38,8 +50,16 @@ struct DetectorOptions {
   // SLAM system / caller decides).
   int opencv_threads = 1;
 
+  [[nodiscard]] cv::Size input() const;
   void check() const;  // throws InputError naming the bad value
 };
+
+inline constexpr int kMaxInputSide = 2048;
+
+// "416x256" or "320" (square) -> size; InputError naming `key` unless each side is a multiple of 32 in
+// 32..kMaxInputSide.
+cv::Size parse_input_size(const std::string& text, const std::string& key);
+std::string input_size_text(cv::Size size);  // "416x256"; "160" when square
 
 class PersonDetector {
  public:

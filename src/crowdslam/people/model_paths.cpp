@@ -27,14 +27,36 @@ bool ends_with(const std::string& text, const std::string& suffix) {
          text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-}  // namespace
-
-std::string default_model_dir() {
+std::vector<std::string> model_dir_candidates() {
   std::vector<std::string> candidates;
   if (const std::string models = env("CROWDSLAM_MODELS"); !models.empty()) candidates.push_back(models);
   candidates.push_back((fs::path(CROWDSLAM_SOURCE_DIR) / "models").string());
   const std::string shared = env("CROWDSLAM_SHARED");
   candidates.push_back((fs::path(shared.empty() ? CROWDSLAM_DEFAULT_SHARED : shared) / "models").string());
+  return candidates;
+}
+
+fs::path folder_of(const std::string& folder) {
+  std::error_code ec;
+  for (const std::string& dir : model_dir_candidates())
+    if (fs::is_directory(fs::path(dir) / folder, ec)) return fs::path(dir) / folder;
+  return fs::path(default_model_dir()) / folder;
+}
+
+}  // namespace
+
+Backend resolved_backend(const ModelFiles& model) {
+  if (model.backend != Backend::kAuto) return model.backend;
+  return ends_with(model.config, ".onnx") ? Backend::kYoloOnnx : Backend::kDarknet;
+}
+
+std::string resolved_preprocess(const ModelFiles& model) {
+  if (!model.preprocess.empty()) return model.preprocess;
+  return resolved_backend(model) == Backend::kYolox ? "yolox" : "darknet";
+}
+
+std::string default_model_dir() {
+  const std::vector<std::string> candidates = model_dir_candidates();
   std::error_code ec;
   for (const std::string& dir : candidates)
     if (fs::is_directory(dir, ec)) return dir;
@@ -42,20 +64,27 @@ std::string default_model_dir() {
 }
 
 ModelFiles resolve_model(const std::string& spec) {
-  const fs::path dir = fs::path(default_model_dir()) / "yolo-fastest-1.1";
-  if (spec == "body")
-    return {(dir / "yolo-fastest-1.1_body.cfg").string(), (dir / "yolo-fastest-1.1_body.weights").string(),
-            0};
-  if (spec == "coco")
-    return {(dir / "yolo-fastest-1.1.cfg").string(), (dir / "yolo-fastest-1.1.weights").string(), 0};
-  if (ends_with(spec, ".cfg")) {
-    return {spec, fs::path(spec).replace_extension(".weights").string(), 0};
+  if (const ZooModel* zoo = find_zoo_model(spec)) {
+    const fs::path dir = folder_of(zoo->folder);
+    ModelFiles m;
+    m.config = (dir / zoo->config).string();
+    m.weights = zoo->weights.empty() ? std::string() : (dir / zoo->weights).string();
+    m.person_class = zoo->person_class;
+    m.backend = zoo->backend;
+    m.preprocess = zoo->preprocess;
+    m.detect_input = zoo->detect_input;
+    m.name = zoo->name;
+    return m;
   }
-  if (ends_with(spec, ".onnx")) return {spec, {}, 0};
-  throw InputError(
-      "--model: expected 'body', 'coco', a Darknet .cfg (with the .weights beside it) or an "
-      ".onnx file, got '" +
-      spec + "'");
+  ModelFiles m;
+  m.config = spec;
+  if (ends_with(spec, ".cfg")) {
+    m.weights = fs::path(spec).replace_extension(".weights").string();
+    return m;
+  }
+  if (ends_with(spec, ".onnx")) return m;
+  throw InputError("detector model: expected one of " + zoo_model_names() +
+                   ", a Darknet .cfg (with the .weights beside it) or an .onnx file, got '" + spec + "'");
 }
 
 }  // namespace crowdslam::people

@@ -6,8 +6,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "crowdslam/people/darknet_detector.h"
-#include "crowdslam/people/model_paths.h"
+#include "crowdslam/people/detector_setup.h"
+#include "crowdslam/people/dnn_detector.h"
 #include "crowdslam/people/mot_file_detector.h"
 #include "crowdslam/util/error.h"
 
@@ -36,23 +36,11 @@ cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vec
 
 std::unique_ptr<people::PersonDetector> make_detector(const io::Settings& settings,
                                                       const PeopleStageOptions& options) {
-  people::DetectorOptions detector_options;
-  detector_options.input_size = settings.detector.input_size;
-  detector_options.confidence = settings.detector.confidence;
-  detector_options.nms = settings.detector.nms;
-  detector_options.person_class = settings.detector.person_class;
+  people::DetectorSetup setup = people::detector_setup(settings.detector, options.detector_model);
   if (!options.detections_file.empty()) {
-    return std::make_unique<people::MotFileDetector>(options.detections_file, detector_options);
+    return std::make_unique<people::MotFileDetector>(options.detections_file, setup.options);
   }
-  std::string spec = options.detector_model.empty() ? settings.detector.model_cfg : options.detector_model;
-  if (spec.empty()) spec = "body";
-  people::ModelFiles model = people::resolve_model(spec);
-  if (!settings.detector.model_weights.empty() && options.detector_model.empty()) {
-    model.weights = settings.detector.model_weights;
-  }
-  if (spec != "body" && spec != "coco") model.person_class = settings.detector.person_class;
-  detector_options.person_class = model.person_class;
-  return std::make_unique<people::DarknetDetector>(model, detector_options);
+  return std::make_unique<people::DnnDetector>(setup.model, setup.options);
 }
 
 }  // namespace
