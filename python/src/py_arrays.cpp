@@ -26,6 +26,9 @@ py::array as_array(const py::handle& object, const std::string& what, const std:
   return py::reinterpret_borrow<py::array>(object);
 }
 
+// dtype checks use py::isinstance<py::array_t<T>>: numpy's equivalence test, so a dtype object that is
+// equal but not the cached one (from a view or a buffer) is accepted too.
+
 // True when OpenCV can describe the array as rows of contiguous pixels (row stride positive and a
 // multiple of the element size; for an (H, W, C) array, channels and pixels packed).
 bool opencv_layout(const py::array& array) {
@@ -72,7 +75,7 @@ std::string describe(const py::handle& object) {
 cv::Mat image_from_array(const py::handle& object, const std::string& what, py::object& keep) {
   const char* expected = "uint8, shape (H, W, 3) BGR or (H, W) grey";
   py::array array = as_array(object, what, expected);
-  if (!array.dtype().is(py::dtype::of<uint8_t>())) {
+  if (!py::isinstance<py::array_t<uint8_t>>(array)) {
     throw py::type_error(what + ": expected " + std::string(expected) + ", got " + describe(array));
   }
   const bool grey = array.ndim() == 2 || (array.ndim() == 3 && array.shape(2) == 1);
@@ -90,8 +93,8 @@ cv::Mat depth_from_array(const py::handle& object, const std::string& what, doub
                          py::object& keep) {
   const char* expected = "uint16 (H, W) raw sensor units or float32 (H, W) metres";
   py::array array = as_array(object, what, expected);
-  const bool u16 = array.dtype().is(py::dtype::of<uint16_t>());
-  const bool f32 = array.dtype().is(py::dtype::of<float>());
+  const bool u16 = py::isinstance<py::array_t<uint16_t>>(array);
+  const bool f32 = py::isinstance<py::array_t<float>>(array);
   if (!u16 && !f32) throw py::type_error(what + ": expected " + std::string(expected) + ", got " + describe(array));
   if (array.ndim() != 2 && !(array.ndim() == 3 && array.shape(2) == 1)) {
     throw py::value_error(what + ": expected " + std::string(expected) + ", got " + describe(array));
@@ -171,7 +174,7 @@ py::array_t<double> trajectory_to_array(const io::Trajectory& trajectory) {
 io::Trajectory trajectory_from_array(const py::handle& object, const std::string& what) {
   const char* expected = "float64, shape (N, 8): timestamp tx ty tz qx qy qz qw";
   const py::array array = as_array(object, what, expected);
-  if (!array.dtype().is(py::dtype::of<double>()) && !array.dtype().is(py::dtype::of<float>())) {
+  if (!py::isinstance<py::array_t<double>>(array) && !py::isinstance<py::array_t<float>>(array)) {
     throw py::type_error(what + ": expected " + std::string(expected) + ", got " + describe(array));
   }
   if (array.ndim() != 2 || array.shape(1) != 8) {

@@ -10,6 +10,7 @@
 #include "crowdslam/util/error.h"
 #include "py_arrays.h"
 #include "py_bindings.h"
+#include "py_gil.h"
 
 namespace crowdslam::python {
 
@@ -23,35 +24,37 @@ py::object optional_text(const std::string& text) { return text.empty() ? py::ob
 class PySequence {
  public:
   PySequence(const std::string& spec, const io::DatasetOptions& options) {
-    py::gil_scoped_release release;  // opening parses every list and checks every image file exists
-    source_ = io::open_source(spec, options);
+    // Opening parses every list and checks that every image file exists.
+    source_ = without_gil([&] { return io::open_source(spec, options); });
     dataset_ = dynamic_cast<io::Dataset*>(source_.get());
   }
 
   // A fresh pass from the first frame (datasets on disk); videos and cameras can be read once.
   size_t start() {
-    py::gil_scoped_release release;
-    std::lock_guard lock(mutex_);
-    prefetcher_.reset();  // joins the reader of an earlier pass
-    if (started_ && !dataset_) {
-      throw std::runtime_error(source_->path() + ": a " + source_->layout() +
-                               " can be iterated only once (it cannot rewind)");
-    }
-    if (dataset_) dataset_->rewind(0);
-    started_ = true;
-    prefetcher_ = std::make_unique<run::FramePrefetcher>(*source_, kPrefetchFrames);
-    return ++generation_;
+    return without_gil([this] {
+      std::lock_guard lock(mutex_);
+      prefetcher_.reset();  // joins the reader of an earlier pass
+      if (started_ && !dataset_) {
+        throw std::runtime_error(source_->path() + ": a " + source_->layout() +
+                                 " can be iterated only once (it cannot rewind)");
+      }
+      if (dataset_) dataset_->rewind(0);
+      started_ = true;
+      prefetcher_ = std::make_unique<run::FramePrefetcher>(*source_, kPrefetchFrames);
+      return ++generation_;
+    });
   }
 
   std::optional<io::Frame> next(size_t generation) {
-    py::gil_scoped_release release;
-    std::lock_guard lock(mutex_);
-    if (generation != generation_ || !prefetcher_) {
-      throw std::runtime_error(source_->path() + ": this iterator is stale (the sequence was iterated again)");
-    }
-    auto frame = prefetcher_->next();
-    if (!frame) prefetcher_.reset();
-    return frame;
+    return without_gil([&] {
+      std::lock_guard lock(mutex_);
+      if (generation != generation_ || !prefetcher_) {
+        throw std::runtime_error(source_->path() + ": this iterator is stale (the sequence was iterated again)");
+      }
+      auto frame = prefetcher_->next();
+      if (!frame) prefetcher_.reset();
+      return frame;
+    });
   }
 
   io::Frame at(py::ssize_t index) {
@@ -63,8 +66,7 @@ class PySequence {
     }
     io::Frame frame;
     frame.info = dataset_->frame_info(static_cast<size_t>(index));
-    py::gil_scoped_release release;
-    frame.images = dataset_->load(static_cast<size_t>(index));
+    frame.images = without_gil([&] { return dataset_->load(static_cast<size_t>(index)); });
     return frame;
   }
 

@@ -8,6 +8,7 @@
 #include "crowdslam/people/model_paths.h"
 #include "py_arrays.h"
 #include "py_bindings.h"
+#include "py_gil.h"
 
 namespace crowdslam::python {
 
@@ -34,19 +35,17 @@ class PyDetector {
     if (nms) options.nms = *nms;
     if (person_class) options.person_class = *person_class;
     options.check();
-    py::gil_scoped_release release;  // loads the network and runs a warm-up forward pass
-    detector_ = std::make_unique<people::DarknetDetector>(files, options);
+    // Loads the network and runs a warm-up forward pass.
+    detector_ = without_gil([&] { return std::make_unique<people::DarknetDetector>(files, options); });
   }
 
   py::tuple detect(const py::object& image, bool raw) {
     py::object keep;
     const cv::Mat mat = image_from_array(image, "detect(): image", keep);
-    people::Detections detections;
-    {
-      py::gil_scoped_release release;
+    const people::Detections detections = without_gil([&] {
       std::lock_guard lock(mutex_);  // one forward pass at a time: a cv::dnn::Net is not thread-safe
-      detections = detector_->detect(mat, frame_index_++);
-    }
+      return detector_->detect(mat, frame_index_++);
+    });
     const auto& boxes = raw ? detections.raw : detections.boxes;
     last_time_ms_ = detections.time_ms;
     return py::make_tuple(boxes_to_array(boxes), box_scores(boxes));

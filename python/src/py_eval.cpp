@@ -6,6 +6,7 @@
 #include "crowdslam/eval/rpe.h"
 #include "py_arrays.h"
 #include "py_bindings.h"
+#include "py_gil.h"
 
 namespace crowdslam::python {
 
@@ -21,8 +22,7 @@ TrajectoryArgument trajectory_argument(const py::object& value, const std::strin
   TrajectoryArgument out;
   if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")) {
     out.name = py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>();
-    py::gil_scoped_release release;  // reading and parsing a file
-    out.trajectory = io::read_trajectory(out.name);
+    out.trajectory = without_gil([&] { return io::read_trajectory(out.name); });  // reading and parsing a file
     return out;
   }
   if (!py::isinstance<py::array>(value)) {
@@ -118,8 +118,7 @@ void bind_eval(py::module_& root) {
         options.check();
         const auto gt = trajectory_argument(ground_truth, "ate()", "ground_truth");
         const auto est = trajectory_argument(estimate, "ate()", "estimate");
-        py::gil_scoped_release release;
-        return eval::evaluate_ate(gt.trajectory, est.trajectory, options, gt.name, est.name);
+        return without_gil([&] { return eval::evaluate_ate(gt.trajectory, est.trajectory, options, gt.name, est.name); });
       },
       py::arg("ground_truth"), py::arg("estimate"), py::arg("align") = "se3", py::arg("max_diff") = 0.02,
       py::arg("offset") = 0.0, py::arg("scale") = 1.0,
@@ -140,8 +139,7 @@ void bind_eval(py::module_& root) {
         options.check();
         const auto gt = trajectory_argument(ground_truth, "rpe()", "ground_truth");
         const auto est = trajectory_argument(estimate, "rpe()", "estimate");
-        py::gil_scoped_release release;
-        return eval::evaluate_rpe(gt.trajectory, est.trajectory, options, gt.name, est.name);
+        return without_gil([&] { return eval::evaluate_rpe(gt.trajectory, est.trajectory, options, gt.name, est.name); });
       },
       py::arg("ground_truth"), py::arg("estimate"), py::arg("delta") = 1.0, py::arg("delta_unit") = "s",
       py::arg("offset") = 0.0, py::arg("scale") = 1.0,

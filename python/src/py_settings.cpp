@@ -4,6 +4,7 @@
 
 #include "crowdslam/io/settings.h"
 #include "py_bindings.h"
+#include "py_gil.h"
 
 namespace crowdslam::python {
 
@@ -69,8 +70,7 @@ void bind_settings(py::module_& m) {
           [](const py::object& path, const std::string& sensor) {
             const std::string file = fspath(path);
             const io::SensorKind kind = sensor_argument(sensor, "Settings.load(): sensor");
-            py::gil_scoped_release release;
-            return io::load_settings(file, kind);
+            return without_gil([&] { return io::load_settings(file, kind); });
           },
           py::arg("path"), py::arg("sensor") = "rgbd",
           "Reads and checks a settings file for the sensor (keys only stereo / RGB-D need are enforced\n"

@@ -11,6 +11,7 @@
 
 #include "crowdslam/util/error.h"
 #include "py_arrays.h"
+#include "py_gil.h"
 
 namespace crowdslam::python {
 
@@ -37,10 +38,8 @@ std::string utc_now() {
 }  // namespace
 
 PySystem::PySystem(SystemArgs args) : args_(std::move(args)) {
-  {
-    py::gil_scoped_release release;  // loading the vocabulary and the detector takes a while
-    system_ = std::make_unique<system::System>(args_.settings, args_.options);
-  }
+  // Loading the vocabulary and the detector takes a while.
+  system_ = without_gil([this] { return std::make_unique<system::System>(args_.settings, args_.options); });
   system_->add_observer(&observer_);
   registry().insert(this);
 }
@@ -65,15 +64,14 @@ void PySystem::stop_all() {
   for (PySystem* s : registry()) open.push_back(py::cast(s, py::return_value_policy::reference));
   for (auto& object : open) {
     auto& s = object.cast<PySystem&>();
-    py::gil_scoped_release release;  // a daemon thread may still be in track(): wait for its frame
-    s.stop_and_destroy();
+    without_gil([&s] { s.stop_and_destroy(); });  // a daemon thread may still be in track(): wait for its frame
   }
 }
 
 system::System& PySystem::live(const char* call) {
   if (!system_) {
     throw std::runtime_error(std::string("System.") + call +
-                             "(): the System was destroyed (interpreter exit); its results are gone");
+                             "(): the System was stopped and destroyed at interpreter exit");
   }
   return *system_;
 }
@@ -131,45 +129,43 @@ FrameResult PySystem::track(const py::object& image, const py::object& depth, co
     throw py::value_error("track(): right: given, but the System's sensor is " + sensor_name +
                           " (right is for sensor=\"stereo\")");
   }
-  FrameResult result;
-  py::gil_scoped_release release;
-  std::lock_guard lock(mutex_);
-  if (closed_) {
-    throw std::runtime_error("System.track(): the System is closed (shutdown(), close() or the end of its `with` "
-                             "block); create a new System to track more frames");
-  }
-  system::System& slam = live("track");
-  check_frame(call, images.colour, images.depth, images.right);
-  result.report = slam.track(images, timestamp_s);
-  result.world_from_cam = observer_.last_pose;
-  return result;
+  return without_gil([&] {
+    std::lock_guard lock(mutex_);
+    system::System& slam = live("track");
+    if (closed_) {
+      throw std::runtime_error("System.track(): the System is closed (shutdown(), close() or the end of its `with` "
+                               "block); create a new System to track more frames");
+    }
+    check_frame(call, images.colour, images.depth, images.right);
+    FrameResult result;
+    result.report = slam.track(images, timestamp_s);
+    result.world_from_cam = observer_.last_pose;
+    return result;
+  });
 }
 
 void PySystem::shutdown() {
-  py::gil_scoped_release release;  // local mapping may still have keyframes queued
-  std::lock_guard lock(mutex_);
-  if (closed_ || !system_) return;
-  system_->shutdown();
-  closed_ = true;
+  without_gil([this] {  // local mapping may still have keyframes queued
+    std::lock_guard lock(mutex_);
+    if (closed_ || !system_) return;
+    system_->shutdown();
+    closed_ = true;
+  });
 }
 
 py::array PySystem::trajectory() {
-  io::Trajectory trajectory;
-  {
-    py::gil_scoped_release release;
+  const io::Trajectory trajectory = without_gil([this] {
     std::lock_guard lock(mutex_);
-    trajectory = live("trajectory").camera_trajectory();
-  }
+    return live("trajectory").camera_trajectory();
+  });
   return trajectory_to_array(trajectory);
 }
 
 py::array PySystem::keyframe_trajectory() {
-  io::Trajectory trajectory;
-  {
-    py::gil_scoped_release release;
+  const io::Trajectory trajectory = without_gil([this] {
     std::lock_guard lock(mutex_);
-    trajectory = live("keyframe_trajectory").keyframe_trajectory();
-  }
+    return live("keyframe_trajectory").keyframe_trajectory();
+  });
   return trajectory_to_array(trajectory);
 }
 
@@ -178,20 +174,19 @@ void PySystem::save_trajectory(const std::string& path, const std::string& forma
   if (name != "tum" && name != "kitti" && name != "euroc") {
     throw py::value_error("save_trajectory(): format: expected 'tum', 'kitti' or 'euroc', got '" + name + "'");
   }
-  py::gil_scoped_release release;
-  std::lock_guard lock(mutex_);
-  system::System& slam = live("save_trajectory");
-  io::write_trajectory(path, keyframes ? slam.keyframe_trajectory() : slam.camera_trajectory(),
-                       io::parse_trajectory_format(name));
+  without_gil([&] {
+    std::lock_guard lock(mutex_);
+    system::System& slam = live("save_trajectory");
+    io::write_trajectory(path, keyframes ? slam.keyframe_trajectory() : slam.camera_trajectory(),
+                         io::parse_trajectory_format(name));
+  });
 }
 
 py::tuple PySystem::map_points() {
-  std::shared_ptr<const system::MapSnapshot> snapshot;
-  {
-    py::gil_scoped_release release;
+  const auto snapshot = without_gil([this] {
     std::lock_guard lock(mutex_);
-    snapshot = live("map_points").map_snapshot();
-  }
+    return live("map_points").map_snapshot();
+  });
   const auto n = snapshot->points.size();
   std::vector<float> positions;
   std::vector<int32_t> observations;
@@ -210,12 +205,10 @@ py::tuple PySystem::map_points() {
 }
 
 py::tuple PySystem::keyframes() {
-  std::shared_ptr<const system::MapSnapshot> snapshot;
-  {
-    py::gil_scoped_release release;
+  const auto snapshot = without_gil([this] {
     std::lock_guard lock(mutex_);
-    snapshot = live("keyframes").map_snapshot();
-  }
+    return live("keyframes").map_snapshot();
+  });
   const auto n = snapshot->keyframes.size();
   std::vector<uint64_t> ids;
   std::vector<double> stamps;
@@ -235,13 +228,11 @@ py::tuple PySystem::keyframes() {
 }
 
 py::dict PySystem::load_map(const std::string& path, bool localization) {
-  mapdb::LoadedMap loaded;
-  {
-    py::gil_scoped_release release;
+  const mapdb::LoadedMap loaded = without_gil([&] {
     std::lock_guard lock(mutex_);
     if (closed_) throw std::runtime_error("System.load_map(): the System is closed");
-    loaded = live("load_map").load_map(path, localization);
-  }
+    return live("load_map").load_map(path, localization);
+  });
   py::dict origin;
   origin["dataset"] = loaded.header.origin.dataset;
   origin["created_utc"] = loaded.header.origin.created_utc;
@@ -257,20 +248,21 @@ py::dict PySystem::load_map(const std::string& path, bool localization) {
 }
 
 void PySystem::save_map(const std::string& path, const std::string& dataset) {
-  py::gil_scoped_release release;
-  std::lock_guard lock(mutex_);
-  system::System& slam = live("save_map");
-  if (!closed_ && !args_.options.sequential) {
-    // System::save_map needs a map nobody writes: in threaded mode local mapping and loop closing do.
-    throw std::runtime_error("System.save_map(): local mapping and loop closing are still running; call "
-                             "shutdown() first (or track with sequential=True)");
-  }
-  mapdb::MapOrigin origin;
-  origin.dataset = dataset;
-  origin.created_utc = utc_now();
-  origin.crowdslam_version = CROWDSLAM_VERSION;
-  origin.end_state = closed_ ? "completed" : "running";
-  slam.save_map(path, origin);
+  without_gil([&] {
+    std::lock_guard lock(mutex_);
+    system::System& slam = live("save_map");
+    if (!closed_ && !args_.options.sequential) {
+      // System::save_map needs a map nobody writes: in threaded mode local mapping and loop closing do.
+      throw std::runtime_error("System.save_map(): local mapping and loop closing are still running; call "
+                               "shutdown() first (or track with sequential=True)");
+    }
+    mapdb::MapOrigin origin;
+    origin.dataset = dataset;
+    origin.created_utc = utc_now();
+    origin.crowdslam_version = CROWDSLAM_VERSION;
+    origin.end_state = closed_ ? "completed" : "running";
+    slam.save_map(path, origin);
+  });
 }
 
 py::dict PySystem::stats() {
@@ -280,8 +272,7 @@ py::dict PySystem::stats() {
   size_t loops = 0;
   std::string detector;
   std::vector<system::MapSegment> segments;
-  {
-    py::gil_scoped_release release;
+  without_gil([&] {
     std::lock_guard lock(mutex_);
     system::System& slam = live("stats");
     tracked = slam.tracked_frames();
@@ -291,7 +282,7 @@ py::dict PySystem::stats() {
     loops = slam.loop_stats().loops.size();
     detector = slam.detector_name();
     segments = slam.segments();
-  }
+  });
   out["tracked_frames"] = tracked;
   out["keyframes"] = keyframes;
   out["map_points"] = points;

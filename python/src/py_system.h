@@ -11,6 +11,7 @@
 // Lifetime: shutdown() (also close() and `with`) lets local mapping and loop closing finish their queues
 // and stops them; the results stay readable. Destroying an open System (garbage collection) or the
 // interpreter exiting (an atexit hook, stop_all()) stops the threads at once instead (stop_now()).
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <atomic>

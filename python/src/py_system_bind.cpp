@@ -1,7 +1,11 @@
 // Python signatures and docstrings of crowdslam.System and crowdslam.FrameResult.
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "py_arrays.h"
+#include "py_gil.h"
 #include "py_system.h"
 
 namespace crowdslam::python {
@@ -18,8 +22,7 @@ io::Settings settings_argument(const py::object& settings, io::SensorKind sensor
   }
   if (py::isinstance<py::str>(settings) || py::hasattr(settings, "__fspath__")) {
     const std::string path = py::str(py::module_::import("os").attr("fspath")(settings)).cast<std::string>();
-    py::gil_scoped_release release;
-    return io::load_settings(path, sensor);
+    return without_gil([&] { return io::load_settings(path, sensor); });
   }
   throw py::type_error("System(): settings: expected a path (str or os.PathLike) or a crowdslam.Settings, got " +
                        describe(settings));

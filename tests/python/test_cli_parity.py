@@ -112,23 +112,27 @@ def test_iterator_yields_every_frame_the_cli_reads_image_folder(synth_sequence: 
     assert all(f.depth is None and f.right is None for f in frames)
 
 
-@pytest.mark.parametrize("name,layout,args", [
-    ("euroc_v101_micro", "euroc", ["--settings", "config/EuRoC.yaml", "--frames", "40"]),
-    ("kitti07_head", "kitti", ["--settings", "config/KITTI04-12.yaml", "--frames", "40"]),
+@pytest.mark.parametrize("name,layout,sensor,args", [
+    ("euroc_v101_micro", "euroc", "stereo", ["--settings", "config/EuRoC.yaml", "--frames", "40"]),
+    ("kitti07_head", "kitti", "monocular", ["--settings", "config/KITTI04-12.yaml", "--sensor", "mono", "--frames", "40"]),
 ])
-def test_iterator_yields_every_frame_the_cli_reads_stereo(name: str, layout: str, args: list[str], tmp_path: Path) -> None:
+def test_iterator_yields_every_frame_the_cli_reads_euroc_kitti(name: str, layout: str, sensor: str, args: list[str],
+                                                               tmp_path: Path) -> None:
     from conftest import SOURCE_DIR
 
     dataset = shared_data(name)
     args = [str(SOURCE_DIR / a) if a.startswith("config/") else a for a in args]
     stamps = frame_stamps_from_cli(dataset, tmp_path, *args)
     seq = crowdslam.datasets.open(dataset)
-    assert seq.layout == layout and seq.sensor == "stereo"
+    assert seq.layout == layout and seq.sensor == sensor
     ours = []
     for frame in seq:
         if len(ours) == len(stamps):
             break
-        assert frame.right is not None and frame.right.shape[:2] == frame.image.shape[:2]
+        if sensor == "stereo":
+            assert frame.right is not None and frame.right.shape[:2] == frame.image.shape[:2]
+        else:
+            assert frame.right is None and frame.depth is None
         ours.append(frame.timestamp)
     assert ours == stamps
     info = json.loads(run_cli("--json", "dataset", "info", str(dataset)).stdout)
