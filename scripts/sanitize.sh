@@ -8,11 +8,14 @@
 # Every run uses the default threaded mode (tracking + detection worker + local mapping + loop closing +
 # frame prefetcher + journal writer), on every sensor: RGB-D (synthetic, bonn_crowd), monocular
 # (bonn_crowd --sensor mono, kitti07_head), stereo (euroc_v101_micro, right-image thread), and a run
-# interrupted by SIGINT mid-way (the fast-stop path), and saved maps (save, localise, continue, export). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are
-# also grepped for reports as a second check).
+# interrupted by SIGINT mid-way (the fast-stop path), and saved maps (save, localise, continue, export);
+# under TSan also the Python API's thread test (a TSan-built module in Debian's python3, libtsan
+# preloaded). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are also
+# grepped for reports as a second check).
 # Environment: CROWDSLAM_JOBS (default 2), CROWDSLAM_SANITIZE_OUT (default out/sanitize),
 #   CROWDSLAM_SANITIZE_BUILD_TYPE (default RelWithDebInfo), CROWDSLAM_SHARED (default ../shared),
-#   CROWDSLAM_SANITIZE_FRAMES (synthetic frames, default 120), CROWDSLAM_SANITIZE_BONN_FRAMES (default 150).
+#   CROWDSLAM_SANITIZE_FRAMES (synthetic frames, default 120), CROWDSLAM_SANITIZE_BONN_FRAMES (default 150),
+#   CROWDSLAM_SANITIZE_PYTHON_FRAMES (frames of the Python thread test, default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$(pwd)"
@@ -24,7 +27,7 @@ for arg in "$@"; do
     address | thread | all) which="$arg" ;;
     --ctest) run_ctest=1 ;;
     -h | --help)
-      sed -n '2,14p' "$0"
+      sed -n '2,18p' "$0"
       exit 0
       ;;
     *)
@@ -127,6 +130,27 @@ set_sanitizer_env() {
   fi
 }
 
+# The Python API's thread-safety test (tests/python/test_threads.py: one Python thread tracking, one
+# reading map_points() repeatedly, threaded and sequential) against the TSan-built module. Debian's python3
+# is not instrumented, so the TSan runtime is preloaded into it; the GIL is a pthread mutex/condvar pair,
+# which TSan's interceptors see, so Python-level hand-offs are not reported as races.
+run_python_threads() {
+  local build_dir="$1" bin="$2" out="$3" t0
+  t0=$(date +%s)
+  if ! configure_and_build thread "$build_dir" crowdslam_python >"$out/python_build.log" 2>&1; then
+    log "tsan python: module build failed, log $out/python_build.log"
+    failures+=("tsan python build")
+    summary+=("tsan python build: FAILED")
+    return 1
+  fi
+  summary+=("tsan python build: $(($(date +%s) - t0)) s")
+  run_step "tsan python threads (pytest tests/python/test_threads.py)" "$out/python_threads.log" \
+    env LD_PRELOAD="$(gcc -print-file-name=libtsan.so)" PYTHONPATH="$build_dir/python" PYTHONDONTWRITEBYTECODE=1 \
+    CROWDSLAM_CLI="$bin" CROWDSLAM_SOURCE_DIR="$root" CROWDSLAM_SHARED_DIR="$shared" \
+    CROWDSLAM_PYTEST_THREAD_FRAMES="${CROWDSLAM_SANITIZE_PYTHON_FRAMES:-30}" \
+    /usr/bin/python3 -m pytest -v -p no:cacheprovider "$root/tests/python/test_threads.py"
+}
+
 configure_and_build() {
   local sanitizer="$1" build_dir="$2"
   shift 2
@@ -212,6 +236,8 @@ run_sanitizer() {
   else
     summary+=("$tag run kitti07_head mono: skipped (no data)")
   fi
+
+  if [[ "$sanitizer" == thread ]]; then run_python_threads "$build_dir" "$bin" "$out" || true; fi
 
   if ((run_ctest)); then
     local t1

@@ -114,6 +114,11 @@ class System {
   [[nodiscard]] bool map_loaded() const { return loaded_map_origin_.has_value(); }
   [[nodiscard]] bool localization_only() const { return tracker_->localization_only(); }
 
+  // A consistent copy of the current map (the one observers get, run_observer.h), for callers that pull
+  // instead of observing (the Python API). Not synchronised with track(): call it from the tracking
+  // thread, or serialise it with track(); local mapping and loop closing may run meanwhile.
+  [[nodiscard]] std::shared_ptr<const MapSnapshot> map_snapshot() const { return take_map_snapshot(); }
+
   // Observers (not owned; see run_observer.h). Add before the first frame.
   void add_observer(RunObserver* observer) { observers_.push_back(observer); }
 
