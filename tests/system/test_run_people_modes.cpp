@@ -1,0 +1,127 @@
+// End-to-end: the detector modes and box tracks on a synthetic crowd whose person boxes are known (the
+// generator's boxes through the MOT-file detector), and the new map after a long loss.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "crowdslam/run/run_sequence.h"
+#include "crowdslam/synth/options.h"
+#include "crowdslam/synth/writer.h"
+#include "test_support.h"
+
+using namespace crowdslam;
+
+namespace {
+std::filesystem::path make_crowd(const test::TempDir& tmp, int frames) {
+  synth::SynthOptions options;
+  options.frames = frames;
+  options.trajectory = synth::TrajectoryKind::kLine;
+  options.people = 3;
+  options.seed = 1;
+  const auto dir = tmp / "crowd";
+  synth::write_sequence(options, dir);
+  return dir;
+}
+
+run::RunSummary run_with(const std::filesystem::path& dataset, const std::filesystem::path& out,
+                         const std::string& mode, const std::string& tracker) {
+  run::RunOptions options;
+  options.dataset = dataset.string();
+  options.out_dir = out.string();
+  options.sequential = true;
+  options.progress = false;
+  options.detections_file = (dataset / "people_gt.txt").string();
+  options.detector_mode = mode;
+  options.box_tracker = tracker;
+  return run::run_sequence(options);
+}
+}  // namespace
+
+TEST(RunPeopleModes, LatestModePropagatesEveryFrameAndStillTracksTheCrowd) {
+  test::TempDir tmp;
+  const auto dataset = make_crowd(tmp, 90);
+  const auto latest = run_with(dataset, tmp / "latest", "latest", "off");
+  EXPECT_EQ(latest.tracked, 90u);
+  ASSERT_TRUE(latest.ate_rmse_m.has_value());
+  EXPECT_LT(*latest.ate_rmse_m, 0.01);
+  const auto& people = latest.json["people_filter"];
+  EXPECT_EQ(people["detector_mode"], "latest");
+  // The detector takes a frame when free and its result is used from the next frame on: no frame waits
+  // for its own boxes, every frame after the first detection has propagated boxes.
+  EXPECT_EQ(people["frames_detected"].get<int>(), 0);
+  EXPECT_GE(people["frames_propagated"].get<int>(), 85);
+  int removed_in_propagated = 0;
+  for (const auto& f : latest.json["frames"]) {
+    EXPECT_EQ(f["detector_wait_ms"].get<double>(), 0.0);
+    if (f["boxes_propagated"].get<bool>()) {
+      EXPECT_LT(f["detection_frame"].get<int64_t>(), f["index"].get<int64_t>());
+      removed_in_propagated += f["keypoints_before_filter"].get<int>() - f["keypoints"].get<int>();
+    }
+  }
+  EXPECT_GT(removed_in_propagated, 0);  // the moved boxes still filter
+}
+
+TEST(RunPeopleModes, TrackerModeUsesConfirmedTracksOnly) {
+  test::TempDir tmp;
+  const auto dataset = make_crowd(tmp, 60);
+  const auto every = run_with(dataset, tmp / "every", "every_frame", "on");
+  EXPECT_EQ(every.tracked, 60u);
+  const auto& people = every.json["people_filter"];
+  EXPECT_TRUE(people["box_tracker"].get<bool>());
+  EXPECT_EQ(people["frames_detected"].get<int>(), 60);
+  EXPECT_GT(people["tracks_started"].get<int>(), 0);
+  // Ground-truth boxes have confidence 1: confirmed at once, so frame 0 is filtered too.
+  EXPECT_GT(every.json["frames"][0]["person_boxes"].get<int>(), 0);
+}
+
+TEST(RunPeopleModes, BadModeValuesNameTheOption) {
+  test::TempDir tmp;
+  const auto dataset = make_crowd(tmp, 5);
+  try {
+    run_with(dataset, tmp / "bad", "sometimes", "off");
+    FAIL() << "expected an InputError";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("--detector-mode"), std::string::npos) << e.what();
+  }
+  try {
+    run_with(dataset, tmp / "bad2", "latest", "maybe");
+    FAIL() << "expected an InputError";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("--box-tracker"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RunPeopleModes, LongLossStartsANewMapAndKeepsTheOldOne) {
+  test::TempDir tmp;
+  synth::SynthOptions options;
+  options.frames = 100;
+  options.trajectory = synth::TrajectoryKind::kLine;
+  options.seed = 2;
+  const auto dir = tmp / "blind";
+  synth::write_sequence(options, dir);
+  // Frames 40-79 black: no features, tracking lost for 40 frames (more than the 30 that start a new map).
+  int blanked = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "rgb")) {
+    const int index = std::stoi(e.path().stem().string());
+    if (index >= 40 && index < 80) {
+      cv::Mat image = cv::imread(e.path().string(), cv::IMREAD_COLOR);
+      image.setTo(cv::Scalar(0, 0, 0));
+      cv::imwrite(e.path().string(), image);
+      ++blanked;
+    }
+  }
+  ASSERT_EQ(blanked, 40);
+  run::RunOptions run;
+  run.dataset = dir.string();
+  run.out_dir = (tmp / "out").string();
+  run.sequential = true;
+  run.progress = false;
+  run.people_filter = false;
+  const auto summary = run::run_sequence(run);
+  // Frames 0-39 in the first map, 80-99 in a new one (the room seen again is far from frame 39's view).
+  EXPECT_GE(summary.tracked, 60u);
+  const auto& segments = summary.json["segments"];
+  ASSERT_GE(segments.size(), 2u);
+  EXPECT_GE(segments[0]["tracked"].get<int>(), 40);
+  EXPECT_GE(segments.back()["tracked"].get<int>(), 15);
+}
