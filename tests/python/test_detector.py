@@ -17,7 +17,10 @@ FRAMES = 12
 @pytest.mark.parametrize("raw", [False, True])
 def test_boxes_equal_cli(synth_sequence: Path, tmp_path: Path, raw: bool) -> None:
     out = tmp_path / "det.txt"
+    # The SLAM filter's detector (the settings' defaults), which crowdslam.Detector() builds; `detect`
+    # without --settings defaults to a detection-quality setup instead, so it is named in full here.
     run_cli("--quiet", "detect", "--dataset", str(synth_sequence), "--out", str(out), "--max-frames", str(FRAMES),
+            "--model", "body", "--input-size", "160", "--confidence", "0.2", "--nms", "0.1",
             *(["--raw"] if raw else []))
     rows = np.loadtxt(out, delimiter=",", ndmin=2)
     detector = crowdslam.Detector("body")

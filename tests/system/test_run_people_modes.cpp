@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <sstream>
 
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
@@ -14,8 +16,7 @@ using namespace crowdslam;
 namespace {
 std::filesystem::path make_crowd(const test::TempDir& tmp, int frames) {
   synth::SynthOptions options;
-  options.frames = frames;
-  options.trajectory = synth::TrajectoryKind::kLine;
+  options.frames = frames;  // the default loop: people in view in about a third of the frames
   options.people = 3;
   options.seed = 1;
   const auto dir = tmp / "crowd";
@@ -65,13 +66,24 @@ TEST(RunPeopleModes, TrackerModeUsesConfirmedTracksOnly) {
   test::TempDir tmp;
   const auto dataset = make_crowd(tmp, 60);
   const auto every = run_with(dataset, tmp / "every", "every_frame", "on");
-  EXPECT_EQ(every.tracked, 60u);
+  // Not all frames: coasting boxes of people who just left remove background, and this sequence loses
+  // track at frame 43 with the tracker (48-49 of 60; 60 without it). Why the tracker is off by default.
+  EXPECT_GE(every.tracked, 40u);
   const auto& people = every.json["people_filter"];
   EXPECT_TRUE(people["box_tracker"].get<bool>());
   EXPECT_EQ(people["frames_detected"].get<int>(), 60);
   EXPECT_GT(people["tracks_started"].get<int>(), 0);
-  // Ground-truth boxes have confidence 1: confirmed at once, so frame 0 is filtered too.
-  EXPECT_GT(every.json["frames"][0]["person_boxes"].get<int>(), 0);
+  // Ground-truth boxes have confidence 1: confirmed at once, so every frame with people has boxes in that
+  // very frame (MOT frame n = frame n - 1 here).
+  std::set<int> with_people;
+  std::istringstream gt(test::read_text(dataset / "people_gt.txt"));
+  for (std::string line; std::getline(gt, line);) {
+    if (!line.empty()) with_people.insert(std::stoi(line) - 1);
+  }
+  ASSERT_FALSE(with_people.empty());
+  for (const int index : with_people) {
+    EXPECT_GT(every.json["frames"][static_cast<size_t>(index)]["person_boxes"].get<int>(), 0) << "frame " << index;
+  }
 }
 
 TEST(RunPeopleModes, BadModeValuesNameTheOption) {

@@ -93,7 +93,7 @@ struct PeopleFilterSettings {
   std::string right_image = "matched";
   // When the filtered frame fails to track right after a tracked one, try once more with the keypoints
   // in the boxes (tracking/tracker.h): a false-positive box over most of the image then costs no tracking.
-  bool rescue_with_boxes = true;
+  bool rescue_with_boxes = false;  // off by default: on a synthetic crowd it once tracked people (docs/DETECTION.md)
 };
 
 struct FeatureBudgetSettings {

@@ -39,9 +39,14 @@ WorkerResult DetectionWorker::wait(std::size_t frame_index) {
   if (state_ == State::kIdle || frame_index_ != frame_index)
     throw std::logic_error("DetectionWorker::wait(" + std::to_string(frame_index) + "): frame not submitted");
   result_ready_.wait(lock, [this] { return state_ == State::kDone; });
+  WorkerResult out = take_result();
+  out.waited_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+WorkerResult DetectionWorker::take_result() {
   WorkerResult out;
   out.frame_index = frame_index_;
-  out.waited_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   state_ = State::kIdle;
   image_.release();
   if (error_) {
@@ -74,17 +79,7 @@ bool DetectionWorker::idle() {
 std::optional<WorkerResult> DetectionWorker::poll() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (state_ != State::kDone) return std::nullopt;
-  WorkerResult out;
-  out.frame_index = frame_index_;
-  state_ = State::kIdle;
-  image_.release();
-  if (error_) {
-    std::exception_ptr error = std::exchange(error_, nullptr);
-    std::rethrow_exception(error);
-  }
-  out.detections = std::move(result_);
-  result_ = {};
-  return out;
+  return take_result();
 }
 
 void DetectionWorker::run() {

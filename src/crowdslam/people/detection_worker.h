@@ -61,6 +61,8 @@ class DetectionWorker {
   enum class State { kIdle, kPending, kRunning, kDone };
 
   void run();
+  // The finished result (state kDone, mutex held); rethrows the detector's exception. Back to kIdle.
+  WorkerResult take_result();
 
   std::unique_ptr<PersonDetector> detector_;
   std::mutex mutex_;
