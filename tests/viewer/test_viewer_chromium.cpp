@@ -65,7 +65,7 @@ TEST(ViewerChromium, LiveRunIsDrawnAndThePauseButtonPausesIt) {
       60))
       << run.current_stderr();
   const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/";
-  start_chromium(url + "?click=pause&after=12", dir / "profile1", "", 100);
+  start_chromium(url + "?click=pause&after=12&points=101", dir / "profile1", "", 100);
 
   // The page reports back what it received; wait for it to have pressed pause.
   nlohmann::json s;

@@ -199,11 +199,12 @@ const std::string& viewer_page_html() {
  document.getElementById('step').onclick = () => control('step');
  document.getElementById('edges').onchange = e => { edgeLines.visible = loopLines.visible = e.target.checked; };
  document.getElementById('showimage').onchange = e => { document.getElementById('imagebox').style.display = e.target.checked ? '' : 'none'; };
- // Tests: ?click=pause&after=N presses a button after N updates.
+ // Tests: ?click=pause&after=N[&points=P] presses a button after N updates (and once P map points are shown).
  let clicked = false;
  function maybeClick() {
   const what = params.get('click');
   if (!what || clicked || updates < Number(params.get('after') || 10)) return;
+  if (Number(body.dataset.points) < Number(params.get('points') || 0)) return;
   clicked = true; document.getElementById(what).click();
  }
 

@@ -3,9 +3,12 @@
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "crowdslam/util/error.h"
 
@@ -142,7 +145,14 @@ void ViewerServer::start() {
     }
     port_ = options_.port;
   }
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  auto returned = std::make_shared<std::atomic<bool>>(false);
+  thread_ = std::thread([this, returned] {
+    server_->listen_after_bind();
+    *returned = true;
+  });
+  // httplib's stop() does nothing until listen has begun (it would leave the thread listening and
+  // stop()'s join hanging), so start() returns only once the server runs.
+  while (!server_->is_running() && !*returned) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 void ViewerServer::stop() {
