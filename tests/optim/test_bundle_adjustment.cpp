@@ -165,12 +165,8 @@ TEST(BundleAdjustment, AbortBeforeSolveReturnsInputUnchanged) {
   const PinholeCamera camera = test_camera();
   const BaScene scene = make_ba_scene(camera, BaSceneSpec{});
   const std::atomic<bool> abort_flag{true};
-  const auto start = std::chrono::steady_clock::now();
   const auto result = local_bundle_adjustment(camera, scene.keyframes, scene.points, scene.observations, {}, &abort_flag);
-  const double elapsed_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   EXPECT_TRUE(result.aborted);
-  EXPECT_LT(elapsed_ms, 50.0);
   EXPECT_TRUE(result.outliers.empty());
   for (std::size_t k = 0; k < scene.keyframes.size(); ++k) {
     EXPECT_EQ(result.keyframes[k].cam_from_world.translation(), scene.keyframes[k].cam_from_world.translation());

@@ -55,15 +55,15 @@ TEST(DetectionWorker, ResultsComeBackForTheRightFrame) {
 }
 
 TEST(DetectionWorker, WaitBlocksUntilTheSlowDetectorIsDone) {
-  DetectionWorker worker(std::make_unique<FakeDetector>(150ms));
+  DetectionWorker worker(std::make_unique<FakeDetector>(600ms));
   const auto start = std::chrono::steady_clock::now();
   worker.submit(3, image_with(1));
   const auto submitted = std::chrono::steady_clock::now();
-  EXPECT_LT(submitted - start, 100ms);  // submit returns at once
+  EXPECT_LT(submitted - start, 300ms);  // submit returns at once, long before the detection ends
   const WorkerResult r = worker.wait(3);
   const auto elapsed = std::chrono::steady_clock::now() - start;
-  EXPECT_GE(elapsed, 150ms);
-  EXPECT_GE(r.waited_ms, 100.0);
+  EXPECT_GE(elapsed, 600ms);
+  EXPECT_GE(r.waited_ms, 300.0);
   EXPECT_EQ(r.detections.boxes.size(), 1u);
 }
 
@@ -74,7 +74,7 @@ TEST(DetectionWorker, WaitAfterTheResultIsReadyDoesNotBlock) {
   worker.submit(0, image_with(1));
   while (fake->calls.load() == 0) std::this_thread::sleep_for(1ms);
   std::this_thread::sleep_for(20ms);
-  EXPECT_LT(worker.wait(0).waited_ms, 15.0);
+  EXPECT_LT(worker.wait(0).waited_ms, 100.0);  // nothing to wait for (a loaded machine may deschedule us briefly)
 }
 
 TEST(DetectionWorker, DetectorExceptionReachesWaitAndWorkerStaysUsable) {
@@ -133,7 +133,7 @@ namespace {
 
 // Decoupled mode: offer() takes a frame only when the worker is free, poll() never blocks.
 TEST(DetectionWorkerLatest, OfferTakesTheNewestFrameWhenFreeAndPollNeverBlocks) {
-  auto detector = std::make_unique<FakeDetector>(60ms);
+  auto detector = std::make_unique<FakeDetector>(600ms);
   DetectionWorker worker(std::move(detector));
   EXPECT_TRUE(worker.idle());
   EXPECT_FALSE(worker.poll().has_value());
@@ -144,7 +144,7 @@ TEST(DetectionWorkerLatest, OfferTakesTheNewestFrameWhenFreeAndPollNeverBlocks) 
   const auto start = std::chrono::steady_clock::now();
   EXPECT_FALSE(worker.offer(1, image_with(1)));  // busy: frame 1 is skipped
   EXPECT_FALSE(worker.poll().has_value());
-  EXPECT_LT(std::chrono::steady_clock::now() - start, 40ms);  // neither blocked on the 60 ms detection
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 300ms);  // neither blocked on the 600 ms detection
   std::optional<WorkerResult> r;
   while (!(r = worker.poll())) std::this_thread::sleep_for(2ms);
   EXPECT_EQ(r->frame_index, 0u);
@@ -158,7 +158,7 @@ TEST(DetectionWorkerLatest, DetectorExceptionReachesPoll) {
   DetectionWorker worker(std::make_unique<FakeDetector>(0ms, 0));
   ASSERT_TRUE(worker.offer(0, image_with(1)));
   bool thrown = false;
-  for (int i = 0; i < 500 && !thrown; ++i) {
+  for (int i = 0; i < 5000 && !thrown; ++i) {
     try {
       if (!worker.poll()) std::this_thread::sleep_for(2ms);
     } catch (const std::runtime_error& e) {
