@@ -41,11 +41,23 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
   map_cmd->require_subcommand(1);
 
   auto file = std::make_shared<std::string>();
+  auto masks = std::make_shared<std::string>();
   auto* info = map_cmd->add_subcommand("info", "Keyframes, points, observations, loops, bounds, sensor, vocabulary");
   info->add_option("file", *file, "Map database")->required();
-  info->callback([file, &global] {
+  info->add_option("--masks", *masks,
+                   "Also count the map points observed on moving pixels: a folder of per-frame masks "
+                   "(NNNNNN.png by frame index, non-zero = moving), e.g. the mask/ of crowdslam synth --movers");
+  info->callback([file, masks, &global] {
     const auto map_info = mapdb::read_map_info(*file);
-    const auto doc = info_json(*file, map_info);
+    auto doc = info_json(*file, map_info);
+    if (!masks->empty()) {
+      const auto m = mapdb::count_points_on_masks(*file, *masks);
+      doc["masks"] = {{"mask_dir", *masks},
+                      {"keyframes_with_mask", m.keyframes_with_mask},
+                      {"points_checked", m.points_checked},
+                      {"points_on_mask", m.points_on_mask},
+                      {"fraction_on_mask", m.fraction()}};
+    }
     if (global.json) {
       print_json(doc);
       return;
@@ -66,6 +78,12 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
               << "covisibility      " << map_info.covisibility_edges << " edges\n"
               << "loop edges        " << map_info.loop_edges << "\n"
               << "bounds            " << b["min"].dump() << " to " << b["max"].dump() << "\n";
+    if (doc.contains("masks")) {
+      const auto& m = doc["masks"];
+      std::cout << "on masks          " << m["points_on_mask"] << " of " << m["points_checked"]
+                << " points seen by the " << m["keyframes_with_mask"] << " keyframes with a mask ("
+                << 100.0 * m["fraction_on_mask"].get<double>() << " %)\n";
+    }
   });
 
   struct ExportArgs {

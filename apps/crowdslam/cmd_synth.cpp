@@ -24,6 +24,10 @@ void add_synth_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("--frames", args->options.frames, "Number of frames (30 fps)")->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "Random seed (textures, people, shake)")->capture_default_str();
   cmd->add_option("--people", args->options.people, "Number of walking people")->capture_default_str();
+  cmd->add_option("--movers", args->options.movers,
+                  "Moving objects that are not people (0-4: sliding crate, door, cart, door); writes mask/ "
+                  "with the moving pixels of each frame")
+      ->capture_default_str();
   cmd->add_flag("--stereo", args->options.stereo, "Rectified stereo pair, KITTI layout, instead of RGB-D");
   cmd->add_option("--trajectory", args->trajectory, "Camera path: loop, line, sweep or handheld")
       ->capture_default_str();

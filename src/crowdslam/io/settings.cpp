@@ -89,6 +89,15 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
   set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
   set_if(r.flag("PeopleFilter.rescue_with_boxes"), s.people_filter.rescue_with_boxes);
+  set_if(r.flag("Geometry.dynamic_check"), s.geometry.dynamic_check);
+  set_if(r.real("Geometry.moving_factor"), s.geometry.moving_factor);
+  set_if(r.real("Geometry.certain_factor"), s.geometry.certain_factor);
+  set_if(r.integer("Geometry.dynamic_score"), s.geometry.dynamic_score);
+  set_if(r.integer("Geometry.cull_score"), s.geometry.cull_score);
+  set_if(r.real("Geometry.region_radius_px"), s.geometry.region_radius_px);
+  set_if(r.real("Geometry.region_depth_m"), s.geometry.region_depth_m);
+  set_if(r.real("Geometry.region_depth_ratio"), s.geometry.region_depth_ratio);
+  set_if(r.integer("Geometry.region_steps"), s.geometry.region_steps);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
   set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
   set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);
@@ -170,11 +179,18 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.people_filter.margin_px == b.people_filter.margin_px &&
                       a.people_filter.depth_margin_m == b.people_filter.depth_margin_m &&
                       a.people_filter.right_image == b.people_filter.right_image;
+  const auto& ga = a.geometry;
+  const auto& gb = b.geometry;
+  const bool geometry = ga.dynamic_check == gb.dynamic_check && ga.moving_factor == gb.moving_factor &&
+                        ga.certain_factor == gb.certain_factor && ga.dynamic_score == gb.dynamic_score &&
+                        ga.cull_score == gb.cull_score && ga.region_radius_px == gb.region_radius_px &&
+                        ga.region_depth_m == gb.region_depth_m && ga.region_depth_ratio == gb.region_depth_ratio &&
+                        ga.region_steps == gb.region_steps;
   const bool budget = a.feature_budget.enabled == b.feature_budget.enabled &&
                       a.feature_budget.thresholds == b.feature_budget.thresholds &&
                       a.feature_budget.factors == b.feature_budget.factors &&
                       a.feature_budget.area == b.feature_budget.area;
-  return camera && orb && detector && people && budget && a.th_depth == b.th_depth &&
+  return camera && orb && detector && people && geometry && budget && a.th_depth == b.th_depth &&
          a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&
          a.has_baseline == b.has_baseline && a.output.trajectory_format == b.output.trajectory_format &&
          same_rectification(a.rectification, b.rectification);

@@ -96,6 +96,19 @@ struct PeopleFilterSettings {
   bool rescue_with_boxes = false;  // off by default: on a synthetic crowd it once tracked people (docs/DETECTION.md)
 };
 
+// Geometric dynamic check of tracked keypoints against the static map (tracking/dynamic_check.h).
+struct GeometrySettings {
+  bool dynamic_check = true;
+  double moving_factor = 2.0;    // residual chi2 above this x the 95 % threshold counts as motion
+  double certain_factor = 0.0;   // one observation above this x makes a keypoint dynamic (0 = never)
+  int dynamic_score = 2;         // map point motion score that makes its keypoints dynamic
+  int cull_score = 3;            // map point motion score at which it is culled
+  double region_radius_px = 20.0;  // region growing radius at 640 px width
+  double region_depth_m = 0.15;    // region growing depth tolerance (or region_depth_ratio x depth)
+  double region_depth_ratio = 0.08;
+  int region_steps = 2;
+};
+
 struct FeatureBudgetSettings {
   bool enabled = true;
   std::vector<double> thresholds{0.0, 0.3, 0.6, 0.9, 0.95};
@@ -119,6 +132,7 @@ struct Settings {
   std::optional<StereoRectification> rectification;
   DetectorSettings detector;
   PeopleFilterSettings people_filter;
+  GeometrySettings geometry;
   FeatureBudgetSettings feature_budget;
   OutputSettings output;
   // Which camera the file describes, whatever sensor it was loaded for: DepthMapFactor present = an

@@ -191,6 +191,19 @@ void check_own_sections(const Checker& c, const Settings& s) {
             "\"matched\" or \"boxes\"", "\"" + p.right_image + "\"");
   c.require(std::isfinite(p.depth_margin_m) && p.depth_margin_m >= 0, "PeopleFilter.depth_margin_m", ">= 0",
             p.depth_margin_m);
+  const auto& g = s.geometry;
+  c.require(std::isfinite(g.moving_factor) && g.moving_factor > 0, "Geometry.moving_factor", "> 0", g.moving_factor);
+  c.require(std::isfinite(g.certain_factor) && (g.certain_factor == 0 || g.certain_factor >= g.moving_factor),
+            "Geometry.certain_factor", "0 (off) or >= Geometry.moving_factor", g.certain_factor);
+  c.require(g.dynamic_score >= 1, "Geometry.dynamic_score", ">= 1", g.dynamic_score);
+  c.require(g.cull_score >= g.dynamic_score, "Geometry.cull_score", ">= Geometry.dynamic_score", g.cull_score);
+  c.require(std::isfinite(g.region_radius_px) && g.region_radius_px >= 0, "Geometry.region_radius_px", ">= 0",
+            g.region_radius_px);
+  c.require(std::isfinite(g.region_depth_m) && g.region_depth_m >= 0, "Geometry.region_depth_m", ">= 0",
+            g.region_depth_m);
+  c.require(std::isfinite(g.region_depth_ratio) && g.region_depth_ratio >= 0, "Geometry.region_depth_ratio", ">= 0",
+            g.region_depth_ratio);
+  c.require(g.region_steps >= 0 && g.region_steps <= 10, "Geometry.region_steps", "in [0, 10]", g.region_steps);
   const auto& b = s.feature_budget;
   if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
   for (std::size_t i = 0; i < b.thresholds.size(); ++i) {

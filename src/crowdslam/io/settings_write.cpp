@@ -105,6 +105,15 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
       << "\nPeopleFilter.right_image: " << quoted(p.right_image)
       << "\nPeopleFilter.rescue_with_boxes: " << (p.rescue_with_boxes ? 1 : 0) << "\n\n";
+  const auto& g = s.geometry;
+  out << "# Geometric dynamic check of tracked keypoints\nGeometry.dynamic_check: " << (g.dynamic_check ? 1 : 0)
+      << "\nGeometry.moving_factor: " << real_text(g.moving_factor)
+      << "\nGeometry.certain_factor: " << real_text(g.certain_factor)
+      << "\nGeometry.dynamic_score: " << g.dynamic_score << "\nGeometry.cull_score: " << g.cull_score
+      << "\nGeometry.region_radius_px: " << real_text(g.region_radius_px)
+      << "\nGeometry.region_depth_m: " << real_text(g.region_depth_m)
+      << "\nGeometry.region_depth_ratio: " << real_text(g.region_depth_ratio)
+      << "\nGeometry.region_steps: " << g.region_steps << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "

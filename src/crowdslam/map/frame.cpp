@@ -12,7 +12,9 @@ Frame::Frame(uint64_t id_in, double timestamp_s_in, std::shared_ptr<const geomet
       levels(std::move(levels_in)),
       features(std::move(features_in)),
       map_points(features->size()),
-      outliers(features->size(), false) {}
+      outliers(features->size(), false),
+      dynamic(features->size(), false),
+      motion_history(features->size(), 0) {}
 
 std::optional<PointProjection> Frame::project(const MapPoint& point, double min_view_cos) const {
   const geometry::Vec3 world = point.world();

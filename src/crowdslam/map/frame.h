@@ -39,6 +39,11 @@ class Frame {
 
   std::vector<std::shared_ptr<MapPoint>> map_points;  // one slot per keypoint (null = unmatched)
   std::vector<bool> outliers;                          // set by pose optimisation
+  // Geometric dynamic check (tracking/dynamic_check.h): keypoints judged to be on something that moves
+  // (kept out of pose optimisation and of new map points), and per keypoint the moving/static verdicts of
+  // its last three checked observations (bits 0-2, newest in bit 0) and how many there were (bits 4-5).
+  std::vector<bool> dynamic;
+  std::vector<uint8_t> motion_history;
   std::optional<geometry::SE3> cam_from_world;
   std::shared_ptr<KeyFrame> reference_keyframe;
 

@@ -194,6 +194,17 @@ void MapPoint::increase_found(int n) {
   found_ += n;
 }
 
+int MapPoint::record_motion(bool moving) {
+  std::lock_guard lock(features_mutex_);
+  motion_score_ = moving ? motion_score_ + 1 : std::max(0, motion_score_ - 1);
+  return motion_score_;
+}
+
+int MapPoint::motion_score() const {
+  std::lock_guard lock(features_mutex_);
+  return motion_score_;
+}
+
 float MapPoint::found_ratio() const {
   std::lock_guard lock(features_mutex_);
   return static_cast<float>(found_) / static_cast<float>(std::max(1, visible_));

@@ -62,6 +62,11 @@ class MapPoint {
   [[nodiscard]] float found_ratio() const;
   [[nodiscard]] int visible_count() const;
   [[nodiscard]] int found_count() const;
+  // Geometric dynamic check (tracking/dynamic_check.h): the evidence that the point moves. Each
+  // observation judged moving adds one, each judged static takes one off (never below 0); returns the
+  // new score. A point with a score >= 2 is treated as dynamic.
+  int record_motion(bool moving);
+  [[nodiscard]] int motion_score() const;
 
   // Saved maps (mapdb/): the viewing geometry and statistics as stored, and their restoration on load.
   struct SavedState {
@@ -95,6 +100,7 @@ class MapPoint {
   Descriptor descriptor_{};
   int visible_ = 1;
   int found_ = 1;
+  int motion_score_ = 0;
   bool bad_ = false;
   std::weak_ptr<MapPoint> replaced_by_;
 };

@@ -41,4 +41,17 @@ struct MapContents {
 };
 MapContents read_map_contents(const std::filesystem::path& map_file, int min_weight = 100);
 
+// How much of a map was built on moving things: the map points observed on a masked pixel in any
+// keyframe whose frame has a mask in `mask_dir` (NNNNNN.png by frame index, non-zero = moving; the
+// mask/ folder of `crowdslam synth --movers`). Throws InputError when no keyframe has a mask.
+struct MaskCount {
+  int keyframes_with_mask = 0;
+  size_t points_checked = 0;  // points seen by those keyframes
+  size_t points_on_mask = 0;
+  [[nodiscard]] double fraction() const {
+    return points_checked == 0 ? 0.0 : static_cast<double>(points_on_mask) / static_cast<double>(points_checked);
+  }
+};
+MaskCount count_points_on_masks(const std::filesystem::path& map_file, const std::filesystem::path& mask_dir);
+
 }  // namespace crowdslam::mapdb

@@ -49,6 +49,10 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"detection_frame", r.detection_frame},
           {"boxes_propagated", r.boxes_propagated},
           {"rescued_with_boxes", r.rescued_with_boxes},
+          {"keypoints_dynamic", r.keypoints_dynamic},
+          {"dynamic_grown", r.dynamic_grown},
+          {"matches_moving", r.matches_moving},
+          {"points_culled_moving", r.points_culled_moving},
           {"stereo_matches", r.stereo_matches},
           {"right_keypoints_removed", r.right_keypoints_removed},
           {"right_wait_ms", r.right_wait_ms},
@@ -190,7 +194,13 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   int rescued = 0;
   double waited_for_mapping_ms = 0;
   int frames_waited = 0;
+  long dynamic_total = 0, grown_total = 0, culled_total = 0;
+  int frames_with_dynamic = 0;
   for (const auto& r : reports) {
+    dynamic_total += r.keypoints_dynamic;
+    grown_total += r.dynamic_grown;
+    culled_total += r.points_culled_moving;
+    frames_with_dynamic += r.keypoints_dynamic > 0 ? 1 : 0;
     rescued += r.rescued_with_boxes ? 1 : 0;
     if (r.detector_ms > 0) detector_ms.push_back(r.detector_ms);  // latest mode: frames with a new detection
     detector_wait_ms.push_back(r.detector_wait_ms);
@@ -219,6 +229,15 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                               {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
                                               {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
                              : nlohmann::json(nullptr);
+  const auto& g = s.geometry;
+  doc["geometry"] = {{"dynamic_check", g.dynamic_check},
+                     {"moving_factor", g.moving_factor},
+                     {"cull_score", g.cull_score},
+                     {"region_radius_px", g.region_radius_px},
+                     {"keypoints_dynamic", dynamic_total},
+                     {"keypoints_grown", grown_total},
+                     {"frames_with_dynamic", frames_with_dynamic},
+                     {"map_points_culled_moving", culled_total}};
   doc["summary"] = {{"frames", summary.frames},
                     {"tracked_frames", summary.tracked},
                     {"tracked_percent", summary.tracked_percent},

@@ -109,6 +109,12 @@ Prepared prepare(const RunOptions& options) {
     }
     p.run_settings.detector.tracker = options.box_tracker == "on";
   }
+  if (!options.geometry.empty()) {
+    if (options.geometry != "on" && options.geometry != "off") {
+      throw InputError("--geometry: expected 'on' or 'off', got '" + clip_text(options.geometry, 60) + "'");
+    }
+    p.run_settings.geometry.dynamic_check = options.geometry == "on";
+  }
   if (p.sensor == io::SensorKind::kStereo) prepare_stereo_settings(*p.source, p.run_settings);
   check_first_frame(*p.source, p.settings);
   return p;

@@ -46,6 +46,7 @@ struct RunOptions {
   std::string filter_mode;          // --filter-mode: overrides PeopleFilter.mode (paper | depth)
   std::string detector_mode;        // --detector-mode: overrides Detector.mode (every_frame | latest)
   std::string box_tracker;          // --box-tracker: overrides Detector.tracker (on | off)
+  std::string geometry;             // --geometry: overrides Geometry.dynamic_check (on | off)
   size_t save_frames = 0;           // --save-frames N: every N-th frame drawn into OUT/frames/
   std::string vocabulary;           // --vocabulary FILE | none ("" = the default vocabulary)
   bool loop_closing = true;         // --no-loop-closing

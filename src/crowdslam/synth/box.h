@@ -20,7 +20,8 @@ struct Box {
   Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5);  // half extents along the box's own axes
   double yaw = 0.0;     // rotation of the box axes about world z (radians)
   bool inside = false;  // true for the room: rays start inside and hit its far side
-  int person_id = 0;    // 0 = static scene
+  int person_id = 0;    // 0 = static scene or a mover
+  int mover_id = 0;     // 0 = static scene or a person (movers.h)
   // Faces in the order -x, +x, -y, +y, -z, +z of the box's own axes.
   std::array<Face, 6> faces{};
 

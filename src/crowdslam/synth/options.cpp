@@ -31,6 +31,9 @@ void SynthOptions::check() const {
   if (people < 0 || people > 50) {
     throw InputError("--people: must be between 0 and 50, got " + std::to_string(people));
   }
+  if (movers < 0 || movers > 4) {
+    throw InputError("--movers: must be between 0 and 4, got " + std::to_string(movers));
+  }
   if (width < 16 || width > 8192) {
     throw InputError("--width: must be between 16 and 8192, got " + std::to_string(width));
   }

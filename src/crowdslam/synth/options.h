@@ -15,6 +15,7 @@ struct SynthOptions {
   int frames = 300;
   std::uint64_t seed = 1;
   int people = 0;
+  int movers = 0;  // moving non-person objects (movers.h), 0..kMaxMovers
   bool stereo = false;
   TrajectoryKind trajectory = TrajectoryKind::kLoop;
   int width = 640;

@@ -153,7 +153,7 @@ std::optional<cv::Rect2d> projected_bounds(const Box& box, const geometry::SE3& 
   return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
 }
 
-RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, const std::vector<Box>& people) {
+RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, const std::vector<Box>& moving) {
   const Intrinsics& k = scene.intrinsics();
   const geometry::SE3 cam_from_world = world_from_cam.inverse();
   const V3 centre = world_from_cam.translation();
@@ -161,12 +161,13 @@ RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, co
 
   std::vector<PreparedBox> boxes;
   for (const Box& b : scene.static_boxes()) boxes.push_back(prepare(b, centre, cam_from_world, k));
-  for (const Box& b : people) boxes.push_back(prepare(b, centre, cam_from_world, k));
+  for (const Box& b : moving) boxes.push_back(prepare(b, centre, cam_from_world, k));
 
   RenderedFrame frame;
   frame.colour.create(k.height, k.width, CV_8UC3);
   frame.depth_m.create(k.height, k.width, CV_32F);
   frame.person_label.create(k.height, k.width, CV_16U);
+  frame.moving.create(k.height, k.width, CV_8U);
   std::vector<const PreparedBox*> row_boxes;
   for (int v = 0; v < k.height; ++v) {
     row_boxes.clear();
@@ -176,6 +177,7 @@ RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, co
     auto* colour_row = frame.colour.ptr<cv::Vec3b>(v);
     auto* depth_row = frame.depth_m.ptr<float>(v);
     auto* label_row = frame.person_label.ptr<std::uint16_t>(v);
+    auto* moving_row = frame.moving.ptr<std::uint8_t>(v);
     for (int u = 0; u < k.width; ++u) {
       const V3 dir_cam((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);  // z = 1: ray parameter = depth
       const V3 dir = rotation * dir_cam;
@@ -192,11 +194,13 @@ RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, co
         colour_row[u] = cv::Vec3b(0, 0, 0);
         depth_row[u] = 0.0f;
         label_row[u] = 0;
+        moving_row[u] = 0;
         continue;
       }
       shade_pixel(scene, best, dir_cam.norm(), k.fx, colour_row[u]);
       depth_row[u] = static_cast<float>(best.hit.t);
       label_row[u] = static_cast<std::uint16_t>(best.prepared->box->person_id);
+      moving_row[u] = best.prepared->box->person_id > 0 || best.prepared->box->mover_id > 0 ? 255 : 0;
     }
   }
   return frame;
@@ -205,7 +209,7 @@ RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, co
 RenderedFrame render_frame(const Scene& scene, int frame, bool right_camera) {
   const geometry::SE3 pose =
       right_camera ? scene.right_world_from_cam(frame) : scene.trajectory().at(frame).world_from_cam;
-  return render(scene, pose, scene.people_boxes(frame));
+  return render(scene, pose, scene.moving_boxes(frame));
 }
 
 }  // namespace crowdslam::synth

@@ -13,11 +13,12 @@ namespace crowdslam::synth {
 struct RenderedFrame {
   cv::Mat colour;        // CV_8UC3, BGR
   cv::Mat depth_m;       // CV_32F z-depth in metres (0 = nothing hit)
-  cv::Mat person_label;  // CV_16U id of the person seen at the pixel (0 = static scene)
+  cv::Mat person_label;  // CV_16U id of the person seen at the pixel (0 = static scene or a mover)
+  cv::Mat moving;        // CV_8U 255 where the pixel shows something that moves (a person or a mover), else 0
 };
 
-// Renders the static scene plus `people` seen by a camera at world_from_cam.
-RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, const std::vector<Box>& people);
+// Renders the static scene plus the moving boxes (people and movers) seen by a camera at world_from_cam.
+RenderedFrame render(const Scene& scene, const geometry::SE3& world_from_cam, const std::vector<Box>& moving);
 // Frame `frame` of the sequence from the left (RGB) or right stereo camera.
 RenderedFrame render_frame(const Scene& scene, int frame, bool right_camera = false);
 

@@ -59,6 +59,10 @@ Scene Scene::build(const SynthOptions& options) {
     const Box& b = scene.static_boxes_[i];
     scene.walk_area_.obstacles.emplace_back((b.center - b.half).head<2>(), (b.center + b.half).head<2>());
   }
+  // Movers draw their textures from a stream of their own, so adding movers leaves the rest of a seed's
+  // scene (textures, people's clothing) as it was; people walk around the floor each mover sweeps.
+  Rng mover_rng(options.seed, 0x30e5);
+  scene.add_movers(mover_rng, photos);
   scene.add_people(rng);
   return scene;
 }
@@ -97,6 +101,34 @@ void Scene::add_people(Rng& rng) {
     person_texture_.push_back(static_cast<int>(textures_.size()));
     textures_.emplace_back(make_clothing(width, height, rng));
   }
+}
+
+void Scene::add_movers(Rng& rng, const std::vector<cv::Mat>& photos) {
+  movers_ = make_movers(options_.movers);
+  for (const Mover& m : movers_) {
+    Box box = m.box_at(0.0);
+    texture_faces(box, rng, photos);
+    mover_templates_.push_back(box);
+    walk_area_.obstacles.push_back(m.footprint());
+  }
+}
+
+std::vector<Box> Scene::mover_boxes(int frame) const {
+  std::vector<Box> boxes;
+  const double t = trajectory_.at(frame).timestamp_s - kFirstTimestampS;
+  for (size_t i = 0; i < movers_.size(); ++i) {
+    Box box = movers_[i].box_at(t);
+    box.faces = mover_templates_[i].faces;
+    for (int face = 0; face < 6; ++face) box.faces[face].shade = shade_for(box.face_normal(face));  // turns with it
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
+std::vector<Box> Scene::moving_boxes(int frame) const {
+  std::vector<Box> boxes = people_boxes(frame);
+  for (Box& b : mover_boxes(frame)) boxes.push_back(std::move(b));
+  return boxes;
 }
 
 std::vector<Box> Scene::people_boxes(int frame) const {

@@ -5,6 +5,7 @@
 
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/synth/box.h"
+#include "crowdslam/synth/movers.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/people.h"
 #include "crowdslam/synth/textures.h"
@@ -29,6 +30,11 @@ class Scene {
   const std::vector<PersonTrack>& people() const { return people_; }
   // The people's textured boxes at a frame (person_id = 1..K).
   std::vector<Box> people_boxes(int frame) const;
+  const std::vector<Mover>& movers() const { return movers_; }
+  // The movers' textured boxes at a frame (mover_id = 1..K).
+  std::vector<Box> mover_boxes(int frame) const;
+  // Everything that moves at a frame: people, then movers.
+  std::vector<Box> moving_boxes(int frame) const;
   const std::vector<Texture>& textures() const { return textures_; }
   bool photo_textures() const { return photo_textures_; }
   const WalkArea& walk_area() const { return walk_area_; }
@@ -39,6 +45,7 @@ class Scene {
   void add_obstacle(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner, Rng& rng,
                     const std::vector<cv::Mat>& photos);
   void add_people(Rng& rng);
+  void add_movers(Rng& rng, const std::vector<cv::Mat>& photos);
   void texture_faces(Box& box, Rng& rng, const std::vector<cv::Mat>& photos);
 
   SynthOptions options_;
@@ -47,6 +54,8 @@ class Scene {
   std::vector<Box> static_boxes_;
   std::vector<PersonTrack> people_;
   std::vector<int> person_texture_;  // texture index per person
+  std::vector<Mover> movers_;
+  std::vector<Box> mover_templates_;  // textured faces per mover (pose set per frame)
   std::vector<Texture> textures_;
   WalkArea walk_area_;
   bool photo_textures_ = false;

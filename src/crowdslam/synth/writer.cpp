@@ -87,6 +87,7 @@ class SequenceWriter {
     const bool stereo = o.stereo;
     fs::create_directories(dir_ / (stereo ? "image_0" : "rgb"));
     fs::create_directories(dir_ / (stereo ? "image_1" : "depth"));
+    if (o.movers > 0) fs::create_directories(dir_ / "mask");
     results_.assign(scene_.frame_count(), {});
     const int threads = std::max(1, std::min(8, static_cast<int>(std::thread::hardware_concurrency())));
     std::vector<std::thread> pool;
@@ -116,7 +117,7 @@ class SequenceWriter {
     const SynthOptions& o = scene_.options();
     const std::string name = frame_name(frame);
     const geometry::SE3& world_from_cam = scene_.trajectory()[frame].world_from_cam;
-    const std::vector<Box> people = scene_.people_boxes(frame);
+    const std::vector<Box> people = scene_.moving_boxes(frame);
     const RenderedFrame left = render(scene_, world_from_cam, people);
     if (o.stereo) {
       write_png(dir_ / "image_0" / name, left.colour);
@@ -125,6 +126,7 @@ class SequenceWriter {
       write_png(dir_ / "rgb" / name, left.colour);
       write_png(dir_ / "depth" / name, depth_png(left.depth_m, o.noise_depth_m, Rng(o.seed, 0xde97ULL + frame)));
     }
+    if (o.movers > 0) write_png(dir_ / "mask" / name, left.moving);
     FrameResult& result = results_[frame];
     result.boxes = visible_person_boxes(scene_, left, world_from_cam, frame);
     result.coverage = static_cast<double>(cv::countNonZero(left.person_label)) / left.person_label.total();
@@ -201,6 +203,9 @@ nlohmann::json synth_json(const Scene& scene, const SequenceSummary& summary) {
   j["seed"] = o.seed;
   j["frames"] = o.frames;
   j["people"] = o.people;
+  j["movers"] = nlohmann::json::array();
+  for (const Mover& m : scene.movers()) j["movers"].push_back({{"id", m.id}, {"kind", to_string(m.kind)}});
+  if (!scene.movers().empty()) j["moving_mask"] = "mask";  // mask/NNNNNN.png: 255 = a person or a mover
   j["stereo"] = o.stereo;
   j["layout"] = o.stereo ? "kitti" : "tum";
   j["trajectory"] = to_string(o.trajectory);

@@ -6,6 +6,9 @@
 // Stereo (--stereo), KITTI odometry layout: image_0/ and image_1/ (BGR PNG), times.txt, calib.txt,
 // poses.txt (KITTI), plus groundtruth.txt, settings.yaml, people_gt.txt, synth.json.
 //
+// With --movers K: mask/NNNNNN.png (8-bit, same name as the image) is 255 where the left/RGB image shows
+// something that moves (a person or a mover) and 0 elsewhere; synth.json lists the movers.
+//
 // people_gt.txt is MOT style, one line per person visible in a frame (at least one pixel):
 //   frame(1-based),id,x,y,w,h,1,-1,-1,-1
 // where (x, y, w, h) is the bounding rectangle of the projection of the person's 3D box in 0-based pixel

@@ -73,6 +73,16 @@ System::System(const io::Settings& settings, const SystemOptions& options)
     // partner (measured on EuRoC and the synthetic sequences), so ask for that many points with depth.
     tracker_options.min_init_features = 250;
   }
+  const io::GeometrySettings& g = settings.geometry;
+  tracker_options.dynamic.enabled = g.dynamic_check;
+  tracker_options.dynamic.moving_factor = g.moving_factor;
+  tracker_options.dynamic.certain_factor = g.certain_factor;
+  tracker_options.dynamic.dynamic_score = g.dynamic_score;
+  tracker_options.dynamic.cull_score = g.cull_score;
+  tracker_options.dynamic.region_radius_px = g.region_radius_px;
+  tracker_options.dynamic.region_depth_m = g.region_depth_m;
+  tracker_options.dynamic.region_depth_ratio = g.region_depth_ratio;
+  tracker_options.dynamic.region_steps = g.region_steps;
   tracker_ = std::make_unique<tracking::Tracker>(tracker_options, map_, mapper_.get());
   if (vocabulary_) {
     keyframe_database_ = std::make_unique<loop::KeyframeDatabase>();
@@ -270,6 +280,10 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.new_keyframe = result.new_keyframe;
   report.rescued_with_boxes = result.rescued_with_boxes;
   report.waited_for_mapping_ms = result.waited_for_mapping_ms;
+  report.keypoints_dynamic = result.dynamic.dynamic;
+  report.dynamic_grown = result.dynamic.grown;
+  report.matches_moving = result.dynamic.moving;
+  report.points_culled_moving = result.dynamic.points_culled;
   report.tracked_points = result.tracked_points;
 
   TrajectoryRecord record;

@@ -73,6 +73,12 @@ struct FrameReport {
   int64_t detection_frame = -1;  // frame the boxes were detected on (-1: none yet)
   bool boxes_propagated = false; // boxes moved here from an earlier frame (Detector.mode latest)
   bool rescued_with_boxes = false;  // tracked only with the keypoints in boxes added back (Tracker::track)
+  // Geometric dynamic check (tracking/dynamic_check.h): keypoints judged dynamic (of them, added by region
+  // growing), matches whose residual moved in this frame, map points culled as moving.
+  int keypoints_dynamic = 0;
+  int dynamic_grown = 0;
+  int matches_moving = 0;
+  int points_culled_moving = 0;
   int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
   // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).

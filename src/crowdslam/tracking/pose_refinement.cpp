@@ -11,6 +11,10 @@ int optimize_frame_pose(map::Frame& frame, const optim::PoseOptimizerOptions& op
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
     if (!p) continue;
+    if (frame.dynamic[i]) {  // known to move: no say in the pose
+      frame.outliers[i] = true;
+      continue;
+    }
     observations.push_back({p->world(), geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y), f.right_u[i],
                             frame.levels->inv_sigma2[f.keys_un[i].octave]});
     slots.push_back(i);
@@ -27,6 +31,7 @@ int discard_outliers_count_map_points(map::Frame& frame) {
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     auto& p = frame.map_points[i];
     if (!p) continue;
+    if (frame.dynamic[i]) continue;  // kept for the dynamic check after the pose; not a tracked point
     if (frame.outliers[i]) {
       p.reset();
       frame.outliers[i] = false;

@@ -35,11 +35,16 @@ void TrackerOptions::check() const {
   if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
   if (max_frames_between_keyframes < 1) throw InputError("tracker: max frames between keyframes must be >= 1");
   pose.check();
+  dynamic.check();
   if (monocular) monocular_init.check();
 }
 
 Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, KeyframeConsumer* mapper)
-    : options_(options), map_(std::move(map)), mapper_(mapper), monocular_initializer_(options.monocular_init) {
+    : options_(options),
+      map_(std::move(map)),
+      mapper_(mapper),
+      monocular_initializer_(options.monocular_init),
+      dynamic_check_(options.dynamic) {
   options_.check();
 }
 
@@ -110,6 +115,12 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
     state_ = ok ? TrackingState::kOk : TrackingState::kLost;
     if (!ok) result.method = "lost";
 
+    if (ok && dynamic_check_.enabled()) {
+      // The pose is final: which of the matches moved (their map points may be culled), and the regions
+      // around them. Dynamic keypoints are no longer tracked points.
+      result.dynamic = dynamic_check_.update(frame, last_frame_ ? &*last_frame_ : nullptr);
+      inliers_in_local_map_ = count_tracked_in_map(frame);
+    }
     if (ok) {
       lost_frames_ = 0;
       if (last_frame_ && last_frame_->cam_from_world) {
@@ -182,7 +193,7 @@ bool Tracker::initialize(map::Frame& frame) {
   map_->add_keyframe(keyframe);
   for (size_t i = 0; i < f.size(); ++i) {
     if (f.depth_m[i] <= 0) continue;
-    auto point = make_point_from_depth(frame, i, keyframe);
+    auto point = make_point_from_depth(frame, i, keyframe, i);
     frame.map_points[i] = point;
   }
   spdlog::info("map initialised with {} points at frame {}", map_->num_map_points(), frame.id);
@@ -198,13 +209,14 @@ bool Tracker::initialize(map::Frame& frame) {
 }
 
 std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& frame, size_t index,
-                                                              const std::shared_ptr<map::KeyFrame>& keyframe) const {
+                                                              const std::shared_ptr<map::KeyFrame>& keyframe,
+                                                              size_t keyframe_index) const {
   const auto& f = *frame.features;
   const geometry::Vec2 pixel(f.keys_un[index].pt.x, f.keys_un[index].pt.y);
   const geometry::Vec3 world = frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[index]);
   auto point = std::make_shared<map::MapPoint>(map_->next_map_point_id(), world, keyframe, frame.id);
-  point->add_observation(keyframe, index);
-  keyframe->add_map_point(index, point);
+  point->add_observation(keyframe, keyframe_index);
+  keyframe->add_map_point(keyframe_index, point);
   point->compute_distinctive_descriptor();
   point->update_normal_and_depth();
   map_->add_map_point(point);
@@ -280,7 +292,20 @@ void Tracker::update_last_frame() {
   }
 }
 
-int Tracker::optimize_pose(map::Frame& frame) const { return optimize_frame_pose(frame, options_.pose); }
+int Tracker::optimize_pose(map::Frame& frame) {
+  // Matches known to move (dynamic_check.h) have no say in the pose.
+  dynamic_check_.inherit(frame, last_frame_ ? &*last_frame_ : nullptr);
+  return optimize_frame_pose(frame, options_.pose);
+}
+
+int Tracker::count_tracked_in_map(const map::Frame& frame) const {
+  int n = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (p && !frame.outliers[i] && !p->is_bad() && p->num_observations() > 0) ++n;
+  }
+  return n;
+}
 
 bool Tracker::track_with_motion_model(map::Frame& frame) {
   update_last_frame();
@@ -427,7 +452,7 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
   int untracked_close = 0;
   const auto& f = *frame.features;
   for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] > 0 && f.depth_m[i] < options_.close_depth_m) {
+    if (f.depth_m[i] > 0 && f.depth_m[i] < options_.close_depth_m && !frame.dynamic[i]) {
       if (frame.map_points[i] && !frame.outliers[i]) {
         ++tracked_close;
       } else {
@@ -452,13 +477,24 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
 }
 
 void Tracker::create_new_keyframe(map::Frame& frame) {
-  if (vocabulary_) ensure_bow(frame, *vocabulary_);  // keyframes carry their bag of words
+  // Dynamic keypoints (dynamic_check.h) are left out of the keyframe, so nothing in the map (points from
+  // depth here, triangulation and fusion in local mapping) is ever made of them.
+  std::vector<long> to_keyframe;
+  std::shared_ptr<const map::FrameFeatures> features = frame.features;
+  if (std::find(frame.dynamic.begin(), frame.dynamic.end(), true) != frame.dynamic.end()) {
+    features = features_without(*frame.features, frame.dynamic, to_keyframe, vocabulary_.get());
+  } else {
+    if (vocabulary_) ensure_bow(frame, *vocabulary_);  // keyframes carry their bag of words
+    features = frame.features;
+    to_keyframe.resize(frame.size());
+    std::iota(to_keyframe.begin(), to_keyframe.end(), 0L);
+  }
   auto keyframe = std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
-                                                  frame.levels, frame.features, *frame.cam_from_world);
+                                                  frame.levels, features, *frame.cam_from_world);
   // The keyframe takes the frame's current matches (the mapper adds the observations).
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    if (frame.map_points[i] && !frame.outliers[i] && !frame.map_points[i]->is_bad()) {
-      keyframe->add_map_point(i, frame.map_points[i]);
+    if (to_keyframe[i] >= 0 && frame.map_points[i] && !frame.outliers[i] && !frame.map_points[i]->is_bad()) {
+      keyframe->add_map_point(static_cast<size_t>(to_keyframe[i]), frame.map_points[i]);
     }
   }
   // New points from the closest depth measurements without a map point.
@@ -470,10 +506,11 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
   std::sort(by_depth.begin(), by_depth.end());
   int count = 0;
   for (const auto& [depth, i] : by_depth) {
+    if (to_keyframe[i] < 0) continue;
     const auto& existing = frame.map_points[i];
     if (!existing || existing->num_observations() < 1 || frame.outliers[i]) {
       frame.outliers[i] = false;
-      frame.map_points[i] = make_point_from_depth(frame, i, keyframe);
+      frame.map_points[i] = make_point_from_depth(frame, i, keyframe, static_cast<size_t>(to_keyframe[i]));
     }
     ++count;
     if (depth > options_.close_depth_m && count > 100) break;

@@ -12,6 +12,7 @@
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map.h"
 #include "crowdslam/optim/pose_optimizer.h"
+#include "crowdslam/tracking/dynamic_check.h"
 #include "crowdslam/tracking/keyframe_consumer.h"
 #include "crowdslam/tracking/monocular_initializer.h"
 #include "crowdslam/tracking/relocalizer.h"
@@ -48,6 +49,8 @@ struct TrackerOptions {
   // their own segment. Never with a loaded map. Usually one second of frames.
   int new_map_after_lost_frames = 30;
   optim::PoseOptimizerOptions pose;
+  // Geometric dynamic check of the tracked keypoints (dynamic_check.h).
+  DynamicCheckOptions dynamic;
   // Monocular: two-view initialisation, ORB-SLAM2's monocular keyframe policy, points only by
   // triangulation (local mapper). See tracker_monocular.cpp.
   bool monocular = false;
@@ -68,6 +71,7 @@ struct TrackResult {
   // Tracked only with the keypoints inside person boxes added back (see Tracker::track).
   bool rescued_with_boxes = false;
   double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
+  DynamicCheckStats dynamic;         // the geometric dynamic check of this frame (zeros when off or lost)
 };
 
 class Tracker {
@@ -115,17 +119,21 @@ class Tracker {
   void update_last_frame();
   void replace_replaced_points(map::Frame& frame) const;
   void update_local_map(const map::Frame& frame);
-  int optimize_pose(map::Frame& frame) const;
+  int optimize_pose(map::Frame& frame);
   KeyframeDecision need_new_keyframe(const map::Frame& frame) const;
   void create_new_keyframe(map::Frame& frame);
+  // A point from keypoint `index`'s depth, observed by `keyframe` as its keypoint `keyframe_index`.
   std::shared_ptr<map::MapPoint> make_point_from_depth(const map::Frame& frame, size_t index,
-                                                       const std::shared_ptr<map::KeyFrame>& keyframe) const;
+                                                       const std::shared_ptr<map::KeyFrame>& keyframe,
+                                                       size_t keyframe_index) const;
+  int count_tracked_in_map(const map::Frame& frame) const;
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
   KeyframeConsumer* mapper_;
   Relocalizer relocalizer_;
   MonocularInitializer monocular_initializer_;
+  DynamicCheck dynamic_check_;
   const loop::KeyframeDatabase* database_ = nullptr;
   std::shared_ptr<const bow::Vocabulary> vocabulary_;
 

@@ -1,0 +1,73 @@
+#pragma once
+// Geometric dynamic check (issue 16): after tracking has estimated a frame's pose against the static map,
+// every keypoint matched to a map point or to a keypoint of the last frame (the visual-odometry points of
+// RGB-D/stereo) is tested against that pose: its reprojection error and, with depth, its disparity error,
+// weighed by the keypoint's pyramid level, as the pose optimisation's chi-square test (2 dof monocular,
+// 3 dof with depth) but at a stricter threshold so that noise does not count as motion.
+//
+// A single bad residual may be a wrong match; motion is what persists. Each keypoint carries the verdicts
+// of its last three checked observations from frame to frame along its matches (Frame::motion_history),
+// and each map point a motion score (MapPoint::record_motion). A keypoint is dynamic when two of its last
+// three observations moved (or, optionally, a single one by far), or when its map point's score says so. Dynamic keypoints then grow into regions: unmatched keypoints next to a
+// dynamic one in the image, at a similar depth when both have one, are dynamic too (up to two steps),
+// so that a moving object's unmatched keypoints go with it.
+//
+// What dynamic means for the rest of tracking: no say in the pose (pose_refinement skips them), no new
+// map points (Tracker::create_new_keyframe leaves them out of the keyframe), and a map point seen moving
+// repeatedly (score >= cull_score) is culled from the map.
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "crowdslam/map/frame.h"
+
+namespace crowdslam::tracking {
+
+struct DynamicCheckOptions {
+  bool enabled = true;
+  // A residual counts as motion above factor x the pose optimisation's chi-square threshold (5.991 with
+  // 2 dof, 7.815 with 3): chi2 > 2 x 7.815 happens to a static point with Gaussian noise 0.14 % of the time.
+  double moving_factor = 2.0;
+  // One observation alone makes a keypoint dynamic above this factor (0 = never: a wrong match can be
+  // as far off as the search window, so by default motion must persist over two observations).
+  double certain_factor = 0.0;
+  int dynamic_score = 2;  // map point motion score that makes its keypoints dynamic (and excluded)
+  int cull_score = 3;     // map point motion score at which the point is culled
+  // Region growing, in pixels at 640 px image width (scaled with the width): radius around a dynamic
+  // keypoint, and depth similarity (|dz| <= max(region_depth_m, region_depth_ratio * z)).
+  double region_radius_px = 20.0;
+  double region_depth_m = 0.15;
+  double region_depth_ratio = 0.08;
+  int region_steps = 2;
+  void check() const;
+};
+
+struct DynamicCheckStats {
+  int checked = 0;         // matches tested against the pose
+  int moving = 0;          // of those, judged moving in this frame
+  int dynamic = 0;         // keypoints dynamic after the check (region growth included)
+  int grown = 0;           // of those, added by region growing
+  int points_culled = 0;   // map points culled as moving
+};
+
+class DynamicCheck {
+ public:
+  explicit DynamicCheck(const DynamicCheckOptions& options);
+
+  [[nodiscard]] bool enabled() const { return options_.enabled; }
+
+  // Before a pose optimisation: marks as dynamic the frame's matches that are known to move (their map
+  // point's score, or the last frame's keypoint they were matched through). `last` may be null.
+  void inherit(map::Frame& frame, const map::Frame* last);
+
+  // After the frame's pose is final: tests every match, updates the keypoints' histories and the map
+  // points' scores, culls map points seen moving repeatedly, and grows regions. `last` may be null.
+  DynamicCheckStats update(map::Frame& frame, const map::Frame* last);
+
+ private:
+  void grow_regions(map::Frame& frame, const std::vector<bool>& judged, DynamicCheckStats& stats) const;
+
+  DynamicCheckOptions options_;
+};
+
+}  // namespace crowdslam::tracking
