@@ -72,6 +72,51 @@ void DynamicCheck::inherit(map::Frame& frame, const map::Frame* last) {
   }
 }
 
+int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& pose_options) const {
+  if (!options_.enabled || options_.min_trusted <= 0 || !frame.cam_from_world) return 0;
+  const auto& f = *frame.features;
+  std::vector<optim::PoseObservation> trusted;
+  size_t candidates = 0;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || frame.dynamic[i] || p->is_bad()) continue;
+    ++candidates;
+    if (p->num_observations() < options_.trusted_observations || p->motion_score() > 0) continue;
+    trusted.push_back({p->world(), geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y), f.right_u[i],
+                       frame.levels->inv_sigma2[f.keys_un[i].octave]});
+  }
+  if (static_cast<int>(trusted.size()) < options_.min_trusted || trusted.size() == candidates) return 0;
+  const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, trusted, pose_options);
+  if (!result.success || result.num_inliers < options_.min_trusted) return 0;
+  frame.cam_from_world = result.cam_from_world;
+  const geometry::PinholeCamera& camera = *frame.camera;
+  int screened = 0;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || frame.dynamic[i] || p->is_bad()) continue;
+    const geometry::Vec3 in_cam = result.cam_from_world * p->world();
+    const bool with_depth = f.has_right(i) && camera.is_stereo();
+    bool disagrees = in_cam.z() <= 0;
+    if (!disagrees) {
+      const geometry::Vec2 pixel = camera.project(in_cam);
+      const double du = f.keys_un[i].pt.x - pixel.x();
+      const double dv = f.keys_un[i].pt.y - pixel.y();
+      double e2 = du * du + dv * dv;
+      if (with_depth) {
+        const double dr = f.right_u[i] - (pixel.x() - camera.bf / in_cam.z());
+        e2 += dr * dr;
+      }
+      disagrees = e2 * frame.levels->inv_sigma2[f.keys_un[i].octave] >
+                  options_.moving_factor * (with_depth ? kChi2Stereo : kChi2Mono);
+    }
+    if (disagrees) {
+      frame.dynamic[i] = true;
+      ++screened;
+    }
+  }
+  return screened;
+}
+
 DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last) {
   DynamicCheckStats stats;
   if (!options_.enabled || !frame.cam_from_world) return stats;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "crowdslam/map/frame.h"
+#include "crowdslam/optim/pose_optimizer.h"
 
 namespace crowdslam::tracking {
 
@@ -39,6 +40,11 @@ struct DynamicCheckOptions {
   double region_depth_m = 0.15;
   double region_depth_ratio = 0.08;
   int region_steps = 2;
+  // Static-first pose: when at least min_trusted matches are trusted (map points seen this often, counting
+  // a depth observation twice, never judged moving), the pose is first estimated from them alone and the
+  // other matches that disagree with it are left out of the full optimisation (0 = off).
+  int trusted_observations = 6;
+  int min_trusted = 30;
   void check() const;
 };
 
@@ -59,6 +65,11 @@ class DynamicCheck {
   // Before a pose optimisation: marks as dynamic the frame's matches that are known to move (their map
   // point's score, or the last frame's keypoint they were matched through). `last` may be null.
   void inherit(map::Frame& frame, const map::Frame* last);
+
+  // Before a pose optimisation, after inherit(): the static-first screening (options above). Sets
+  // frame.cam_from_world to the trusted pose and marks the matches that disagree with it dynamic for the
+  // optimisation (update() judges them afresh). Returns the number of matches screened out.
+  int screen(map::Frame& frame, const optim::PoseOptimizerOptions& pose_options) const;
 
   // After the frame's pose is final: tests every match, updates the keypoints' histories and the map
   // points' scores, culls map points seen moving repeatedly, and grows regions. `last` may be null.

@@ -295,6 +295,7 @@ void Tracker::update_last_frame() {
 int Tracker::optimize_pose(map::Frame& frame) {
   // Matches known to move (dynamic_check.h) have no say in the pose.
   dynamic_check_.inherit(frame, last_frame_ ? &*last_frame_ : nullptr);
+  dynamic_check_.screen(frame, options_.pose);
   return optimize_frame_pose(frame, options_.pose);
 }
 
