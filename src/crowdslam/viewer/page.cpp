@@ -175,7 +175,7 @@ const std::string& viewer_page_html() {
  function showStatus(f) {
   const text = f ? ['frame ' + f.index, f.state + (f.method ? ' (' + f.method + ')' : ''), f.fps.toFixed(1) + ' frames/s',
    'keyframes ' + mapInfo.keyframes, 'points ' + mapInfo.points, 'loops ' + mapInfo.loops,
-   'people ' + (100 * f.people_area).toFixed(1) + ' %', 'budget ' + f.feature_budget, f.paused ? 'PAUSED' : ''] : ['waiting for the run'];
+   'people ' + (100 * f.people_area).toFixed(1) + ' %', 'budget ' + f.feature_budget, f.paused ? 'PAUSED' : ''] : [note ? '' : 'waiting for the run'];
   const line = text.concat(note ? [note] : []).filter(Boolean).join('  |  ');
   if (statusBar.textContent !== line) statusBar.textContent = line;  // no layout when nothing changed
  }
