@@ -18,6 +18,7 @@
 #include "crowdslam/people/mot_format.h"
 #include "crowdslam/people/mot_sequence.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/progress.h"
 
 namespace crowdslam::app {
 namespace {
@@ -116,14 +117,19 @@ void run_detect(DetectArgs& args, const GlobalOptions& global) {
   std::vector<people::FrameBoxes> frames;
   std::vector<double> times_ms;
   std::size_t boxes = 0;
+  const std::size_t expected = source->summary().frames.value_or(0);
+  const std::size_t total =
+      args.max_frames > 0 && (expected == 0 || args.max_frames < expected) ? args.max_frames : expected;
+  ProgressLine progress(!global.quiet, total, "frame");
   while (auto frame = source->next()) {
     if (args.max_frames > 0 && frames.size() >= args.max_frames) break;
     people::Detections d = detector.detect(frame->images.colour, frame->info.index);
     times_ms.push_back(d.time_ms);
     boxes += (args.raw ? d.raw : d.boxes).size();
     frames.push_back({frame->info.index, args.raw ? std::move(d.raw) : std::move(d.boxes)});
-    if (frames.size() % 100 == 0) spdlog::info("{} frames", frames.size());
+    progress.update(frames.size(), fmt::format("boxes {}  {:.1f} ms", frames.back().boxes.size(), d.time_ms));
   }
+  progress.finish();
   people::write_mot_detections(args.out, frames);
   double mean_ms = 0.0;
   for (double t : times_ms) mean_ms += t;

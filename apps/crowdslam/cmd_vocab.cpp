@@ -2,7 +2,6 @@
 // `crowdslam vocab info`: size and load time of a vocabulary (our binary format or DBoW2 text).
 // `crowdslam vocab convert`: DBoW2 / ORB-SLAM2 text vocabulary (ORBvoc.txt) -> our binary format.
 #include <spdlog/spdlog.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +19,7 @@
 #include "crowdslam/io/image_check.h"
 #include "crowdslam/io/image_folder_dataset.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/progress.h"
 
 namespace crowdslam::app {
 namespace {
@@ -29,65 +29,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
-
-// Progress on stderr: one rewritten line on a terminal (at most 10 updates a second), otherwise
-// spdlog info lines at milestones only. Only warnings with --quiet or --json (stdout stays pure JSON).
-class Progress {
- public:
-  explicit Progress(const GlobalOptions& global)
-      : json_(global.json),
-        tty_(!global.quiet && !global.json && ::isatty(STDERR_FILENO) == 1),
-        log_(!global.quiet && !global.json && !tty_) {}
-  ~Progress() { end_line(); }
-  Progress(const Progress&) = delete;
-  Progress& operator=(const Progress&) = delete;
-
-  // A transient status (terminal only).
-  void status(const std::string& text, bool force = false) {
-    if (!tty_) return;
-    const auto now = Clock::now();
-    if (!force && open_ && now - last_ < std::chrono::milliseconds(100)) return;
-    last_ = now;
-    std::fprintf(stderr, "\r%-*s", static_cast<int>(std::max<std::size_t>(width_, text.size())),
-                 text.c_str());
-    std::fflush(stderr);
-    width_ = text.size();
-    open_ = true;
-  }
-  // A milestone: the final status line on a terminal, a log line otherwise.
-  void milestone(const std::string& text) {
-    if (tty_) {
-      status(text, true);
-      end_line();
-    } else if (log_) {
-      spdlog::info("{}", text);
-    }
-  }
-  // A warning: always shown, on stderr (spdlog writes to stdout, which --json keeps for the document).
-  void warn(const std::string& text) {
-    end_line();
-    if (json_) {
-      std::fprintf(stderr, "[warning] %s\n", text.c_str());
-    } else {
-      spdlog::warn("{}", text);
-    }
-  }
-  void end_line() {
-    if (!open_) return;
-    std::fputc('\n', stderr);
-    std::fflush(stderr);
-    open_ = false;
-    width_ = 0;
-  }
-
- private:
-  bool json_;
-  bool tty_;
-  bool log_;
-  bool open_ = false;
-  std::size_t width_ = 0;
-  Clock::time_point last_{};
-};
 
 struct TrainArgs {
   std::vector<std::string> inputs;
@@ -105,10 +46,27 @@ struct Collected {
   std::size_t rows = 0;
 };
 
+bool is_image_file(const std::string& input) {
+  std::error_code ec;
+  return fs::is_regular_file(input, ec) && io::is_image_file_name(input);
+}
+
+// Images the inputs will give (every --every-th frame of each, at most --max-images); 0: unknown (an input
+// that does not know its frame count).
+std::size_t expected_images(const TrainArgs& args) {
+  std::size_t images = 0;
+  for (const std::string& input : args.inputs) {
+    const std::size_t frames = is_image_file(input) ? 1 : io::open_source(input)->summary().frames.value_or(0);
+    if (frames == 0) return args.max_images;
+    images += is_image_file(input) ? 1 : (frames + args.every - 1) / args.every;
+  }
+  return args.max_images > 0 ? std::min(images, args.max_images) : images;
+}
+
 // Collects ORB descriptors image by image, input by input, until `max_images` are in.
 class DescriptorCollector {
  public:
-  DescriptorCollector(const TrainArgs& args, Progress& progress) : args_(args), progress_(progress) {
+  DescriptorCollector(const TrainArgs& args, ProgressLine& progress) : args_(args), progress_(progress) {
     feature::ORBExtractor::Options orb;  // the defaults of config/TUM1.yaml: 1000, 1.2, 8, 20/7
     orb.num_features = args.features;
     orb.check();
@@ -117,7 +75,7 @@ class DescriptorCollector {
 
   bool full() const { return args_.max_images > 0 && result_.images >= args_.max_images; }
 
-  void add(const cv::Mat& image, const std::string& source) {
+  void add(const cv::Mat& image) {
     std::vector<cv::KeyPoint> keypoints;
     cv::Mat descriptors;
     extractor_->extract(feature::to_gray(image), keypoints, descriptors);
@@ -126,39 +84,38 @@ class DescriptorCollector {
       result_.rows += static_cast<std::size_t>(descriptors.rows);
       result_.descriptors.push_back(descriptors);
     }
-    progress_.status("reading: " + std::to_string(result_.images) + " images, " +
-                     std::to_string(result_.rows) + " descriptors (" + source + ")");
+    progress_.update(result_.images, std::to_string(result_.rows) + " descriptors");
   }
 
   // Every image of one input (an image file, a folder, a dataset or a video).
   void add_input(const std::string& input) {
     const std::size_t images_before = result_.images;
     const std::size_t rows_before = result_.rows;
-    std::error_code ec;
-    if (fs::is_regular_file(input, ec) && io::is_image_file_name(input)) {
-      if (!full()) add(io::read_colour_image(input), input);
+    if (is_image_file(input)) {
+      if (!full()) add(io::read_colour_image(input));
     } else {
       const auto source = io::open_source(input);
       std::size_t index = 0;
       while (!full()) {
         const auto frame = source->next();
         if (!frame) break;
-        if (index++ % args_.every == 0) add(frame->images.colour, input);
+        if (index++ % args_.every == 0) add(frame->images.colour);
       }
     }
     const std::size_t images = result_.images - images_before;
     const std::size_t rows = result_.rows - rows_before;
-    if (images > 0 && rows == 0)
-      progress_.warn(input + ": no ORB features in " + std::to_string(images) + " image(s)");
-    progress_.milestone("read " + input + ": " + std::to_string(images) + " images, " + std::to_string(rows) +
-                        " descriptors");
+    if (images > 0 && rows == 0) {
+      progress_.end_line();
+      spdlog::warn("{}: no ORB features in {} image(s)", input, images);
+    }
+    spdlog::debug("read {}: {} images, {} descriptors", input, images, rows);
   }
 
   Collected take() { return std::move(result_); }
 
  private:
   const TrainArgs& args_;
-  Progress& progress_;
+  ProgressLine& progress_;
   std::unique_ptr<feature::ORBExtractor> extractor_;
   Collected result_;
 };
@@ -190,32 +147,36 @@ void check_train_args(const TrainArgs& args) {
 
 void run_train(TrainArgs& args, const GlobalOptions& global) {
   check_train_args(args);
-  Progress progress(global);
+  const bool show_progress = !global.quiet;
   const auto start = Clock::now();
-  DescriptorCollector collector(args, progress);
+  ProgressLine read_progress(show_progress, expected_images(args), "image");
+  DescriptorCollector collector(args, read_progress);
   for (const std::string& input : args.inputs) {
     if (collector.full()) break;
     collector.add_input(input);
   }
+  read_progress.finish();
   const Collected data = collector.take();
   const double read_s = seconds_since(start);
   if (data.rows == 0) {
     throw input_error(join(args.inputs), "no ORB descriptors in " + std::to_string(data.images) +
                                              " image(s): nothing to train a vocabulary on");
   }
-  progress.milestone("read " + std::to_string(data.images) + " images, " + std::to_string(data.rows) +
-                     " descriptors in " + fmt::format("{:.1f}", read_s) + " s");
+  spdlog::info("read {} images, {} descriptors in {:.1f} s", data.images, data.rows, read_s);
 
+  // One progress line per tree level (descriptors clustered at that level).
+  std::unique_ptr<ProgressLine> level_progress;
   int last_level = 0;
   args.options.progress = [&](const bow::VocabularyTrainProgress& p) {
-    const int percent =
-        static_cast<int>(100 * p.descriptors_done / std::max<std::size_t>(p.descriptors_total, 1));
-    progress.status(fmt::format("k-means: level {}/{}, {}%", p.level, p.levels, percent),
-                    p.level != last_level);
-    last_level = p.level;
-    if (p.descriptors_done == p.descriptors_total)
-      progress.milestone(fmt::format("k-means: level {}/{} done after {:.1f} s", p.level, p.levels,
-                                     seconds_since(start) - read_s));
+    if (p.level != last_level) {
+      level_progress = std::make_unique<ProgressLine>(show_progress, p.descriptors_total, "descriptor");
+      last_level = p.level;
+    }
+    level_progress->update(p.descriptors_done, fmt::format("k-means level {}/{}", p.level, p.levels));
+    if (p.descriptors_done == p.descriptors_total) {
+      level_progress.reset();  // its last line
+      spdlog::info("k-means: level {}/{} done after {:.1f} s", p.level, p.levels, seconds_since(start) - read_s);
+    }
   };
   const auto train_start = Clock::now();
   const bow::Vocabulary voc = bow::Vocabulary::train(data.descriptors, args.options);

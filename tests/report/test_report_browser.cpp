@@ -16,8 +16,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kChartsWithGroundTruth =
-    8;  // 2 trajectory views, error, frame time, mapping, people, features, tracking
+// 2 trajectory views, error, frame time, mapping (steps' median/p95 and each keyframe), people, features,
+// tracking.
+constexpr int kChartsWithGroundTruth = 9;
 
 #define REQUIRE_CHROMIUM()                                                            \
   do {                                                                                \

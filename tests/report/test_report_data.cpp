@@ -13,6 +13,7 @@
 #include "crowdslam/report/page_data.h"
 #include "crowdslam/report/report.h"
 #include "crowdslam/report/run_data.h"
+#include "crowdslam/run/run_document.h"
 #include "report_test_helpers.h"
 
 using namespace crowdslam;
@@ -230,6 +231,69 @@ TEST_F(ReportRun, MovedDatasetGivesAReportWithoutGroundTruth) {
   EXPECT_FALSE(run.evaluated_segment.has_value());
   // Shown as tracked, in the run's own frame.
   EXPECT_EQ(run.segments[0].aligned.size(), summary_->tracked);
+}
+
+TEST_F(ReportRun, MapperTimeOfEveryKeyframeInRunJsonAndThePage) {
+  const auto doc = read_json(out_ / "run.json");
+  const auto& mapping = doc["local_mapping"];
+  const auto& list = mapping["keyframe_times_ms"];
+  ASSERT_TRUE(list.is_array());
+  ASSERT_GT(mapping["keyframes_processed"].get<size_t>(), 2u);
+  ASSERT_EQ(list.size(), mapping["keyframes_processed"].get<size_t>());
+  std::vector<double> totals;
+  for (size_t n = 0; n < list.size(); ++n) {
+    const auto& k = list[n];
+    EXPECT_EQ(k["n"].get<size_t>(), n);
+    double steps = 0;
+    for (const char* step : {"register", "triangulation", "fusion", "local_ba", "culling"}) {
+      EXPECT_GE(k[step].get<double>(), 0.0) << n << " " << step;
+      steps += k[step].get<double>();
+    }
+    EXPECT_GE(k["total"].get<double>() + 1e-9, steps) << "keyframe " << n;  // the steps are parts of the total
+    totals.push_back(k["total"].get<double>());
+  }
+  // The list is what the summary aggregates.
+  EXPECT_DOUBLE_EQ(run::percentile(totals, 0.5), mapping["per_keyframe_ms"]["total"]["median"].get<double>());
+  EXPECT_DOUBLE_EQ(run::percentile(totals, 0.95), mapping["per_keyframe_ms"]["total"]["p95"].get<double>());
+
+  const auto page = report::page_data({report::load_run(out_)}, {});
+  const auto& keyframes = page["runs"][0]["mapping"]["keyframes"];
+  ASSERT_TRUE(keyframes.is_object());
+  for (const char* key : {"n", "register", "triangulation", "fusion", "local_ba", "culling", "total"})
+    EXPECT_EQ(keyframes[key].size(), list.size()) << key;
+  EXPECT_NEAR(keyframes["total"].back().get<double>(), list.back()["total"].get<double>(), 1e-3);
+
+  // A run.json written before the list existed still gives a page (without the per-keyframe chart's data).
+  const auto dir = copy_run("no_keyframe_times");
+  auto old = read_json(dir / "run.json");
+  old["local_mapping"].erase("keyframe_times_ms");
+  write_json(dir / "run.json", old);
+  EXPECT_TRUE(report::page_data({report::load_run(dir)}, {})["runs"][0]["mapping"]["keyframes"].is_null());
+}
+
+TEST_F(ReportRun, RelativeDatasetPathIsWrittenAbsoluteSoTheReportFindsTheGroundTruthFromAnywhere) {
+  const fs::path start = fs::current_path();
+  const fs::path relative = fs::relative(dataset_, start);
+  ASSERT_TRUE(relative.is_relative()) << relative;
+  const auto out = tmp_->path() / "relative_dataset";
+  test::run_room(relative, out, true);
+  const auto doc = read_json(out / "run.json");
+  const fs::path written = doc["dataset"].get<std::string>();
+  EXPECT_TRUE(written.is_absolute()) << written;
+  EXPECT_TRUE(fs::equivalent(written, dataset_)) << written;
+
+  // From another working directory (where the relative path names nothing) the report still has it.
+  // Deeper than the first one, so that the path's ".." do not climb back to "/".
+  auto elsewhere = tmp_->path() / "elsewhere";
+  for (auto part = start.begin(); part != start.end(); ++part) elsewhere /= "d";
+  fs::create_directories(elsewhere);
+  fs::current_path(elsewhere);
+  const bool relative_resolves_here = fs::exists(relative);
+  const auto run = report::load_run(out);
+  fs::current_path(start);
+  EXPECT_FALSE(relative_resolves_here);
+  EXPECT_FALSE(run.ground_truth.empty()) << run.ground_truth_note;
+  EXPECT_TRUE(run.evaluated_segment.has_value());
 }
 
 TEST(Report, RunWhoseReportFailsKeepsItsOutputsAndExitCode) {

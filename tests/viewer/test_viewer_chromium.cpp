@@ -81,6 +81,8 @@ TEST(ViewerChromium, LiveRunIsDrawnAndThePauseButtonPausesIt) {
   EXPECT_GE(s["client"]["updates"].get<int>(), 12);
   EXPECT_EQ(s["client"]["webgl"], "yes");
   EXPECT_GT(s["client"]["points"].get<int>(), 100);
+  EXPECT_GT(s["client"]["images"].get<int>(), 0) << s.dump();  // the camera image drawn too
+  EXPECT_GT(s["client"]["renders"].get<int>(), 0) << s.dump();
   // Paused: the run's frame count stops advancing.
   std::this_thread::sleep_for(500ms);
   const int frames = state(port)["run"]["frames"].get<int>();

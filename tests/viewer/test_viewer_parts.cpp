@@ -1,7 +1,12 @@
 // The live viewer's parts (issue 13): the event stream, the pause control, the HTTP server's routes,
 // refusals, a port in use and clients that go away.
 #include <gtest/gtest.h>
+// Before httplib.h: it includes <resolv.h>, whose _res macro breaks Eigen's headers.
+#include "crowdslam/viewer/viewer_observer.h"
+
 #include <httplib.h>
+
+#include <opencv2/core.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -30,6 +35,75 @@ TEST(EventStream, NewClientGetsTheNewestOfEachEventThenEverythingLive) {
   const auto live = stream.wait(cursor, 10ms);
   ASSERT_EQ(live.size(), 4u);  // bounded: only the newest 4 are kept
   EXPECT_EQ(*live.back(), "event: frame\ndata: 5\n\n");
+}
+
+TEST(EventStream, AClientThatSkipsAnEventNeverGetsItAndPastResetsAreNotReplayed) {
+  viewer::EventStream stream;
+  stream.publish("image", "1");
+  stream.publish("frame", "1");
+  stream.publish("reset", "{}", false);  // not retained for late clients
+  viewer::EventStream::Cursor no_images;
+  no_images.skip = {"image"};
+  auto first = stream.wait(no_images, 10ms);
+  ASSERT_EQ(first.size(), 1u);  // the newest frame: no image, no past reset
+  EXPECT_EQ(*first[0], "event: frame\ndata: 1\n\n");
+  stream.publish("image", "2");
+  stream.publish("frame", "2");
+  const auto live = stream.wait(no_images, 10ms);
+  ASSERT_EQ(live.size(), 1u);
+  EXPECT_EQ(*live[0], "event: frame\ndata: 2\n\n");
+  viewer::EventStream::Cursor everything;
+  EXPECT_EQ(stream.wait(everything, 10ms).size(), 2u);  // newest image and frame
+}
+
+TEST(EventStream, AnEventIsTakenWhileARegisteredClientDoesNotSkipIt) {
+  viewer::EventStream stream;
+  EXPECT_FALSE(stream.taken("image"));  // nobody connected
+  auto hides_image = stream.register_client({"image"});
+  EXPECT_FALSE(stream.taken("image"));
+  EXPECT_TRUE(stream.taken("frame"));
+  {
+    auto shows_image = stream.register_client({});
+    EXPECT_TRUE(stream.taken("image"));
+  }
+  EXPECT_FALSE(stream.taken("image"));  // released with its handle
+  hides_image.reset();
+  EXPECT_FALSE(stream.taken("frame"));
+}
+
+TEST(ViewerObserver, EncodesImagesOnlyWhileAPageTakesThem) {
+  viewer::EventStream stream;
+  viewer::ViewerObserverOptions options;
+  options.frame_interval_s = 0;  // every frame's status and image (no timing in the test)
+  options.image_interval_s = 0;
+  io::FrameImages images;
+  images.colour = cv::Mat(48, 64, CV_8UC3, cv::Scalar(10, 20, 30));
+  system::FrameReport report;
+  {
+    viewer::ViewerObserver observer(stream, nullptr, options);
+    observer.on_frame(report, std::nullopt, images);  // no page connected
+    auto hides_image = stream.register_client({"image"});
+    report.index = 1;
+    observer.on_frame(report, std::nullopt, images);
+    auto shows_image = stream.register_client({});
+    report.index = 2;
+    observer.on_frame(report, std::nullopt, images);
+    observer.stop();  // publishes what it queued
+  }
+  viewer::EventStream::Cursor all;
+  all.started = true;  // everything from the start, not just the newest of each event
+  size_t frames = 0, image_messages = 0;
+  std::string image;
+  for (const auto& m : stream.wait(all, 10ms)) {
+    if (m->rfind("event: frame\n", 0) == 0) ++frames;
+    if (m->rfind("event: image\n", 0) == 0) {
+      ++image_messages;
+      image = *m;
+    }
+  }
+  EXPECT_EQ(frames, 3u);
+  EXPECT_EQ(image_messages, 1u);
+  EXPECT_NE(image.find("\"index\":2"), std::string::npos) << image.substr(0, 200);
 }
 
 TEST(EventStream, CloseWakesAWaitingClientAtOnce) {

@@ -83,6 +83,23 @@ std::string ate_text(const RunData& run, const JsonFields& f) {
   return text + ")";
 }
 
+// Each keyframe's mapping time by step, as columns {"n": [...], "register": [...], ..., "total": [...]}, from
+// run.json's local_mapping.keyframe_times_ms (null for runs written before it existed).
+nlohmann::json keyframe_times(const JsonFields& f) {
+  const auto& list = f.find("local_mapping.keyframe_times_ms");
+  if (!list.is_array()) return nullptr;
+  nlohmann::json columns;
+  for (const char* key : {"n", "register", "triangulation", "fusion", "local_ba", "culling", "total"}) {
+    nlohmann::json column = nlohmann::json::array();
+    for (size_t k = 0; k < list.size(); ++k) {
+      column.push_back(rounded(f.number_in(list[k], "local_mapping.keyframe_times_ms[" + std::to_string(k) + "]", key),
+                               1e-3));
+    }
+    columns[key] = std::move(column);
+  }
+  return columns;
+}
+
 }  // namespace
 
 ViewAxes choose_view_axes(const io::Trajectory& reference) {
@@ -284,6 +301,7 @@ nlohmann::json run_page_data(const RunData& run, const FrameStripOptions& strip)
       mapping["p95"].push_back(rounded(f.number(key + ".p95"), 1e-3));
     }
     mapping["keyframes_processed"] = f.find("local_mapping.keyframes_processed");
+    mapping["keyframes"] = keyframe_times(f);
     out["mapping"] = std::move(mapping);
   } else {
     out["mapping"] = nullptr;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 
 #include "crowdslam/eval/ate.h"
 #include "crowdslam/eval/rpe.h"
@@ -28,6 +29,14 @@ std::string utc_now() {
   return text;
 }
 }  // namespace
+
+std::string dataset_path(const std::string& spec) {
+  std::error_code ec;
+  if (spec.empty() || !std::filesystem::exists(spec, ec)) return spec;  // a camera index
+  // Not lexically normalised: "a/link/.." is not "a" when link is a symbolic link.
+  const auto absolute = std::filesystem::absolute(spec, ec);
+  return ec ? spec : absolute.string();
+}
 
 double percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0;
@@ -171,7 +180,7 @@ nlohmann::json running_document(const RunOptions& options, const std::string& se
           {"end_state", "running"},
           {"pid", static_cast<long>(::getpid())},
           {"started", utc_now()},
-          {"dataset", options.dataset},
+          {"dataset", dataset_path(options.dataset)},
           {"settings", settings_path},
           {"sensor", io::to_string(sensor)},
           {"mode", options.sequential ? "sequential" : "threaded"}};
@@ -289,6 +298,20 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                              {"local_ba", step(&mapping::KeyframeStepTimes::ba_ms)},
                                              {"culling", step(&mapping::KeyframeStepTimes::culling_ms)},
                                              {"total", step(&mapping::KeyframeStepTimes::total_ms)}};
+  // Each keyframe's times, in the order the mapper processed them (n counts from 0; the mapper does not
+  // record keyframe ids with its times).
+  nlohmann::json keyframe_times = nlohmann::json::array();
+  for (size_t n = 0; n < mapper.per_keyframe.size(); ++n) {
+    const auto& k = mapper.per_keyframe[n];
+    keyframe_times.push_back({{"n", n},
+                              {"register", k.register_ms},
+                              {"triangulation", k.triangulation_ms},
+                              {"fusion", k.fusion_ms},
+                              {"local_ba", k.ba_ms},
+                              {"culling", k.culling_ms},
+                              {"total", k.total_ms}});
+  }
+  doc["local_mapping"]["keyframe_times_ms"] = std::move(keyframe_times);
   if (slam.loop_closing_enabled()) {
     const auto loops = slam.loop_stats();
     nlohmann::json events = nlohmann::json::array();

@@ -26,6 +26,9 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
 void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary);
 
 double percentile(std::vector<double> values, double q);
+// The dataset as run.json names it: an existing path made absolute (the report finds the ground truth
+// from any working directory), anything else (a camera index) as given.
+std::string dataset_path(const std::string& spec);
 
 // The run.json header written before the first frame ("end_state": "running").
 nlohmann::json running_document(const RunOptions& options, const std::string& settings_path, io::SensorKind sensor);

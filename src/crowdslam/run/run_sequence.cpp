@@ -127,6 +127,14 @@ void write_final_outputs(const std::filesystem::path& out, const system::System&
   write_file_atomic(out / "run.json", doc.dump(1) + "\n");
 }
 
+// What the progress line shows after the counts: state, tracked frames, keyframes, map points, people.
+std::string progress_detail(const system::System& slam, const system::FrameReport& report) {
+  char detail[160];
+  std::snprintf(detail, sizeof detail, "%s  tracked %zu  keyframes %zu  points %zu  people %.0f %%",
+                tracking::to_string(report.state), slam.tracked_frames(), slam.num_keyframes(), slam.num_map_points(),
+                100.0 * report.people_area);
+  return detail;
+}
 }  // namespace
 
 RunSummary run_sequence(const RunOptions& options) {
@@ -216,23 +224,15 @@ RunSummary run_sequence(const RunOptions& options) {
       std::vector<cv::KeyPoint>().swap(report.removed_keypoints);
       std::vector<people::PersonBox>().swap(report.boxes);
       journal.check();
-      if (progress.on_terminal()) {  // one line redrawn in place
-        char detail[160];
-        std::snprintf(detail, sizeof detail, "%s  tracked %zu  keyframes %zu  people %.0f %%",
-                      tracking::to_string(report.state), slam.tracked_frames(), slam.num_keyframes(),
-                      100.0 * report.people_area);
-        progress.update(reports.size(), detail);
-      } else if (options.progress && reports.size() % 100 == 0) {  // plain lines in logs and CI
-        spdlog::info("frame {}/{}: {} tracked, {} keyframes, {} map points", reports.size(), expected,
-                     slam.tracked_frames(), slam.num_keyframes(), slam.num_map_points());
-      }
+      // A line redrawn in place, or a plain line in logs and CI (the detail takes the map's lock: only then).
+      if (progress.due(reports.size())) progress.update(reports.size(), progress_detail(slam, report));
     }
   } catch (const std::exception& e) {
     end.kind = system::EndState::Kind::kFailed;
     end.reason = e.what();
     error = std::current_exception();
   }
-  progress.finish();
+  progress.finish(reports.size(), reports.empty() ? std::string() : progress_detail(slam, reports.back()));
   const double wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
   prefetcher.cancel();
   slam.finish(end);  // stops the threads; the journal drains and closes

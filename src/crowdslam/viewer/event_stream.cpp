@@ -4,15 +4,15 @@
 
 namespace crowdslam::viewer {
 
-void EventStream::publish(const std::string& event, const std::string& data) {
+void EventStream::publish(const std::string& event, const std::string& data, bool retain) {
   auto message = std::make_shared<const std::string>("event: " + event + "\ndata: " + data + "\n\n");
   {
     std::lock_guard lock(mutex_);
     if (closed_) return;
     ++sequence_;
-    recent_.emplace_back(sequence_, message);
+    recent_.push_back({sequence_, event, message});
     while (recent_.size() > capacity_) recent_.pop_front();
-    newest_by_event_[event] = {sequence_, message};
+    if (retain) newest_by_event_[event] = {sequence_, event, message};
   }
   cv_.notify_all();
 }
@@ -20,22 +20,54 @@ void EventStream::publish(const std::string& event, const std::string& data) {
 std::vector<EventStream::Message> EventStream::wait(Cursor& cursor, std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   std::vector<Message> out;
+  const auto wanted = [&](const Entry& entry) { return cursor.skip.count(entry.event) == 0; };
   if (!cursor.started) {
     // A new client: the newest message of each event, in publishing order, then everything after.
     cursor.started = true;
-    std::vector<std::pair<uint64_t, Message>> newest;
-    for (const auto& entry : newest_by_event_) newest.push_back(entry.second);
-    std::sort(newest.begin(), newest.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (auto& entry : newest) out.push_back(std::move(entry.second));
+    std::vector<const Entry*> newest;
+    for (const auto& [event, entry] : newest_by_event_) {
+      if (wanted(entry)) newest.push_back(&entry);
+    }
+    std::sort(newest.begin(), newest.end(), [](const Entry* a, const Entry* b) { return a->sequence < b->sequence; });
+    for (const Entry* entry : newest) out.push_back(entry->message);
     cursor.seen = sequence_;
     if (!out.empty() || closed_) return out;
   }
   cv_.wait_for(lock, timeout, [&] { return closed_ || sequence_ > cursor.seen; });
-  for (const auto& [seq, message] : recent_) {
-    if (seq > cursor.seen) out.push_back(message);
+  for (const auto& entry : recent_) {
+    if (entry.sequence > cursor.seen && wanted(entry)) out.push_back(entry.message);
   }
   cursor.seen = std::max(cursor.seen, sequence_);
   return out;
+}
+
+std::shared_ptr<void> EventStream::register_client(const std::set<std::string>& skip, int image_width) {
+  image_width = std::max(0, image_width);
+  {
+    std::lock_guard lock(mutex_);
+    ++clients_;
+    for (const auto& event : skip) ++skipping_[event];
+    image_widths_.insert(image_width);
+  }
+  // The handle's deleter unregisters (the stream outlives the server and its clients).
+  return std::shared_ptr<void>(nullptr, [this, skip, image_width](void*) {
+    std::lock_guard lock(mutex_);
+    --clients_;
+    for (const auto& event : skip) --skipping_[event];
+    image_widths_.erase(image_widths_.find(image_width));
+  });
+}
+
+int EventStream::image_width() const {
+  std::lock_guard lock(mutex_);
+  if (image_widths_.empty() || *image_widths_.begin() == 0) return 0;
+  return *image_widths_.rbegin();
+}
+
+bool EventStream::taken(const std::string& event) const {
+  std::lock_guard lock(mutex_);
+  const auto it = skipping_.find(event);
+  return clients_ > (it == skipping_.end() ? 0 : it->second);
 }
 
 void EventStream::close() {

@@ -2,7 +2,9 @@
 // The viewer's outgoing messages as Server-Sent Events: producers publish (event name, JSON data), each
 // connected client reads everything after its cursor. Bounded: only the newest `capacity` messages are
 // kept, and the newest message of each event name is retained for clients that connect late (they get
-// the current map, image and status first). Thread-safe.
+// the current map, image and status first). A client may refuse event names (a page that hides its image
+// takes no "image"); producers ask whether any connected client takes an event before making it.
+// Thread-safe.
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -10,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,28 +24,45 @@ class EventStream {
 
   explicit EventStream(size_t capacity = 64) : capacity_(capacity) {}
 
-  void publish(const std::string& event, const std::string& data);
+  // `retain` false: not replayed to clients that connect later (a past event such as a map reset).
+  void publish(const std::string& event, const std::string& data, bool retain = true);
   // A client's position in the stream.
   struct Cursor {
     uint64_t seen = 0;     // sequence number of the last message it got
     bool started = false;  // a new client first gets the retained newest message of every event name
+    std::set<std::string> skip;  // event names it does not take
   };
   // Messages published after `cursor` (which is advanced), waiting up to `timeout` for one; empty on
   // timeout or once closed.
   std::vector<Message> wait(Cursor& cursor, std::chrono::milliseconds timeout);
+  // Counts a connected client (the events it skips, the image width it shows, 0: any) until the returned
+  // handle is released.
+  [[nodiscard]] std::shared_ptr<void> register_client(const std::set<std::string>& skip, int image_width = 0);
+  // Whether a registered client takes `event`.
+  [[nodiscard]] bool taken(const std::string& event) const;
+  // The widest image a registered client shows; 0 when one takes any width (or none said).
+  [[nodiscard]] int image_width() const;
   // Wakes every waiting client; later waits return at once.
   void close();
   [[nodiscard]] bool closed() const;
   [[nodiscard]] uint64_t published() const;
 
  private:
+  struct Entry {
+    uint64_t sequence;
+    std::string event;
+    Message message;
+  };
   const size_t capacity_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<std::pair<uint64_t, Message>> recent_;
-  std::map<std::string, std::pair<uint64_t, Message>> newest_by_event_;
+  std::deque<Entry> recent_;
+  std::map<std::string, Entry> newest_by_event_;
   uint64_t sequence_ = 0;
   bool closed_ = false;
+  size_t clients_ = 0;
+  std::map<std::string, size_t> skipping_;  // registered clients that skip each event
+  std::multiset<int> image_widths_;          // of registered clients (0: any width)
 };
 
 }  // namespace crowdslam::viewer

@@ -14,8 +14,8 @@ const std::string& viewer_page_html() {
  body { margin: 0; font: 13px sans-serif; background: #111; color: #ddd; overflow: hidden; }
  #scene { position: absolute; left: 0; top: 32px; right: 0; bottom: 28px; }
  #bar { position: absolute; left: 0; right: 0; top: 0; height: 32px; background: #222; display: flex; gap: 6px; align-items: center; padding: 0 8px; }
- #status { position: absolute; left: 0; right: 0; bottom: 0; height: 28px; line-height: 28px; background: #222; padding: 0 8px; white-space: nowrap; overflow: hidden; }
- #imagebox { position: absolute; right: 8px; top: 40px; width: 36%; max-width: 640px; background: #000; border: 1px solid #444; line-height: 0; }
+ #status { position: absolute; left: 0; right: 0; bottom: 0; height: 28px; line-height: 28px; background: #222; padding: 0 8px; white-space: nowrap; overflow: hidden; contain: strict; }
+ #imagebox { position: absolute; right: 8px; top: 40px; width: 36%; max-width: 640px; background: #000; border: 1px solid #444; line-height: 0; contain: layout paint; }
  #image { width: 100%; height: auto; display: block; }
  button, label { color: #ddd; background: #333; border: 1px solid #555; padding: 3px 8px; border-radius: 3px; }
  #legend { margin-left: auto; color: #999; }
@@ -42,13 +42,26 @@ const std::string& viewer_page_html() {
  'use strict';
  const body = document.body;
  const params = new URLSearchParams(location.search);
- let updates = 0, renders = 0, dirty = true;
- body.dataset.updates = '0'; body.dataset.frame = '-1'; body.dataset.points = '0'; body.dataset.webgl = 'no';
+ const noRender = Boolean(params.get('norender'));  // diagnostics: no WebGL drawing
+ // WebGL drawn by the CPU (SwiftShader, llvmpipe: no GPU, or a headless browser) takes the cores SLAM
+ // runs on: then no antialiasing (4x the pixels to shade) and half the page updates.
+ // The renderer starts without antialiasing and is made again with it when the GPU draws.
+ function isSoftware(renderer) {
+  const gl = renderer.getContext(), info = gl.getExtension('WEBGL_debug_renderer_info');
+  return /swiftshader|llvmpipe|softpipe|software/i.test(info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '');
+ }
+ let renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+ const softwareGl = isSoftware(renderer);
+ if (!softwareGl) { renderer.dispose(); renderer.forceContextLoss(); renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true }); }
+ // The event handlers only keep the newest state; apply() shows it at most 4 times a second (2 with
+ // software WebGL): every page update costs layout, painting and compositing.
+ const APPLY_INTERVAL_MS = softwareGl ? 500 : 250;
+ let updates = 0, renders = 0;
+ body.dataset.updates = '0'; body.dataset.frame = '-1'; body.dataset.points = '0'; body.dataset.webgl = 'yes';
+ body.dataset.softwareGl = String(softwareGl);
 
  // Scene: the SLAM frame is x right, y down, z forward; the root flips it so that up is up.
  const container = document.getElementById('scene');
- const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
- body.dataset.webgl = 'yes';
  renderer.setClearColor(0x111111);
  container.appendChild(renderer.domElement);
  const scene = new THREE.Scene();
@@ -60,11 +73,29 @@ const std::string& viewer_page_html() {
  scene.add(root);
  scene.add(new THREE.AxesHelper(0.3));
 
+ // Drawing: only when something changed, never in a loop. Mouse moves draw on the next animation frame;
+ // updates draw at once (a page whose animation frames are suspended, as in a headless screenshot, still
+ // shows the newest state).
+ function render() {
+  if (noRender) return;
+  renderer.render(scene, camera);
+  renders += 1; body.dataset.renders = String(renders);
+ }
+ let renderQueued = false;
+ function renderNextFrame() {
+  if (renderQueued) return;
+  renderQueued = true;
+  requestAnimationFrame(function () { renderQueued = false; render(); });
+ }
+ controls.addEventListener('change', renderNextFrame);
+
  function resize() {
   const w = container.clientWidth || 800, h = container.clientHeight || 600;
   renderer.setSize(w, h); camera.aspect = w / h; camera.updateProjectionMatrix();
+  renderNextFrame();
  }
- window.addEventListener('resize', resize); resize();
+ window.addEventListener('resize', function () { resize(); if (source && imageShown() && shownImageWidth() !== imageWidth) connect(); });
+ resize();
 
  // Map points.
  const pointGeometry = new THREE.BufferGeometry();
@@ -83,7 +114,7 @@ const std::string& viewer_page_html() {
  root.add(trajectoryLine, groundTruthLine);
  const cameraLines = new THREE.LineSegments(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0x33ff66 }));
  root.add(cameraLines);
- let scale = 0.1;  // frustum size: a tenth of the map's extent, at most 10 cm... updated with the map
+ let scale = 0.1;  // frustum size: 2 % of the map's extent, between 2 and 15 cm (set with the map)
 
  function frustum(pose, size, out) {
   const m = new THREE.Matrix4().compose(new THREE.Vector3(pose[0], pose[1], pose[2]),
@@ -99,7 +130,8 @@ const std::string& viewer_page_html() {
  }
 
  let keyframePoses = new Map();
- function onMap(m) {
+ let mapInfo = { points: 0, keyframes: 0, loops: 0 };
+ function showMap(m) {
   const n = m.point_ids.length, pos = new Float32Array(3 * n), col = new Float32Array(3 * n), ids = new Set();
   let min = [Infinity, Infinity, Infinity], max = [-Infinity, -Infinity, -Infinity];
   for (let i = 0; i < n; ++i) {
@@ -127,34 +159,38 @@ const std::string& viewer_page_html() {
   mapInfo = { points: n, keyframes: m.keyframes.length, loops: m.loops_closed };
   body.dataset.points = String(n);
  }
- let mapInfo = { points: 0, keyframes: 0, loops: 0 };
- let lastFrame = null;
- function onFrame(f) {
-  lastFrame = f;
+ function showFrame(f) {
   body.dataset.frame = String(f.index);
-  if (f.pose) {
-   trajectory.push(f.pose[0], f.pose[1], f.pose[2]);
-   setPositions(trajectoryLine.geometry, trajectory);
-   const lines = []; frustum(f.pose, 1.5 * scale, lines); setPositions(cameraLines.geometry, lines);
-   if (document.getElementById('follow').checked) {
-    const p = new THREE.Vector3(f.pose[0], f.pose[1], f.pose[2]).applyMatrix4(root.matrixWorld);
-    const shift = p.clone().sub(controls.target); controls.target.copy(p); camera.position.add(shift);
-   }
+  setPositions(trajectoryLine.geometry, trajectory);
+  if (!f.pose) return;
+  const lines = []; frustum(f.pose, 1.5 * scale, lines); setPositions(cameraLines.geometry, lines);
+  if (document.getElementById('follow').checked) {
+   root.updateMatrixWorld();
+   const p = new THREE.Vector3(f.pose[0], f.pose[1], f.pose[2]).applyMatrix4(root.matrixWorld);
+   const shift = p.clone().sub(controls.target); controls.target.copy(p); camera.position.add(shift);
   }
-  showStatus();
  }
- function showStatus(extra) {
-  const f = lastFrame;
+ const statusBar = document.getElementById('status');
+ let note = '';  // 'map reset', 'run completed', 'disconnected'
+ function showStatus(f) {
   const text = f ? ['frame ' + f.index, f.state + (f.method ? ' (' + f.method + ')' : ''), f.fps.toFixed(1) + ' frames/s',
    'keyframes ' + mapInfo.keyframes, 'points ' + mapInfo.points, 'loops ' + mapInfo.loops,
-   'people ' + (100 * f.people_area).toFixed(1) + ' %', 'budget ' + f.feature_budget, f.paused ? 'PAUSED' : ''] : ['waiting for the run'];
-  document.getElementById('status').textContent = text.concat(extra ? [extra] : []).filter(Boolean).join('  |  ');
+   'people ' + (100 * f.people_area).toFixed(1) + ' %', 'budget ' + f.feature_budget, f.paused ? 'PAUSED' : ''] : [note ? '' : 'waiting for the run'];
+  const line = text.concat(note ? [note] : []).filter(Boolean).join('  |  ');
+  if (statusBar.textContent !== line) statusBar.textContent = line;  // no layout when nothing changed
  }
- const canvas = document.getElementById('image'), ctx = canvas.getContext('2d');
- function onImage(m) {
+ // The image: only the newest, only while shown, one decode at a time.
+ const imageBox = document.getElementById('imagebox'), canvas = document.getElementById('image'), ctx = canvas.getContext('2d');
+ let decoding = false, imagesDrawn = 0;
+ function imageShown() { return document.getElementById('showimage').checked; }
+ function showImage(m) {
   const img = new Image();
+  decoding = true;
+  img.onerror = function () { decoding = false; };
   img.onload = function () {
-   canvas.width = m.width; canvas.height = m.height; ctx.drawImage(img, 0, 0);
+   decoding = false;
+   if (canvas.width !== m.width || canvas.height !== m.height) { canvas.width = m.width; canvas.height = m.height; }
+   ctx.drawImage(img, 0, 0); imagesDrawn += 1;
    ctx.lineWidth = 2; ctx.strokeStyle = '#3388ff';
    for (const b of m.boxes) ctx.strokeRect(b[0], b[1], b[2], b[3]);
    const dots = (flat, colour) => { ctx.fillStyle = colour; for (let i = 0; i + 1 < flat.length; i += 2) ctx.fillRect(flat[i] - 1.5, flat[i + 1] - 1.5, 3, 3); };
@@ -162,33 +198,52 @@ const std::string& viewer_page_html() {
   };
   img.src = 'data:image/jpeg;base64,' + m.jpeg;
  }
- function onTrajectory(m, line) { setPositions(line.geometry, m.positions); }
+
+ // The newest state not shown yet (raw JSON text: a superseded image or map is never parsed).
+ const pending = { frame: null, map: null, image: null, groundTruth: null, trajectory: null };
+ let lastFrame = null, applyTimer = 0, lastApply = -Infinity;
+ function scheduleApply() {
+  if (applyTimer) return;
+  applyTimer = setTimeout(apply, Math.max(0, lastApply + APPLY_INTERVAL_MS - performance.now()));
+ }
+ function apply() {
+  applyTimer = 0; lastApply = performance.now();
+  let changed = false;
+  if (pending.map) { showMap(JSON.parse(pending.map)); pending.map = null; changed = true; }
+  if (pending.groundTruth) { setPositions(groundTruthLine.geometry, JSON.parse(pending.groundTruth).positions); pending.groundTruth = null; changed = true; }
+  if (pending.trajectory) { setPositions(trajectoryLine.geometry, pending.trajectory); pending.trajectory = null; changed = true; }
+  if (pending.frame) { lastFrame = pending.frame; pending.frame = null; showFrame(lastFrame); changed = true; }
+  if (pending.image && imageShown() && !decoding) { showImage(JSON.parse(pending.image)); pending.image = null; }
+  showStatus(lastFrame);
+  if (changed) render();
+  maybeClick();
+  if (pending.image && imageShown()) scheduleApply();  // decoding the previous one: try again later
+ }
 
  // Events.
- function count() {
-  updates += 1; body.dataset.updates = String(updates); dirty = true; maybeClick();
-  setTimeout(renderSoon, 0);  // after the handler has applied the update
- }
- // Rendering is driven by animation frames, and also (throttled) by updates: a page whose animation
- // frames are suspended (hidden tab, headless screenshot) still shows the newest state.
- let lastRender = 0;
- function renderSoon() {
-  const now = performance.now();
-  if (now - lastRender < 200 || params.get('norender')) return;
-  lastRender = now; dirty = false; renderer.render(scene, camera); renders += 1; body.dataset.renders = String(renders);
- }
+ function count() { updates += 1; body.dataset.updates = String(updates); maybeClick(); scheduleApply(); }
+ // The server sends images only to pages that show them (it encodes none when no page does), no wider
+ // than shown (in steps of 160 device pixels).
+ let source = null, imageWidth = 0;
+ function shownImageWidth() { return 160 * Math.max(1, Math.ceil(imageBox.clientWidth * (window.devicePixelRatio || 1) / 160)); }
  function connect() {
-  const source = new EventSource('/events');
-  source.addEventListener('frame', e => { count(); onFrame(JSON.parse(e.data)); });
-  source.addEventListener('map', e => { count(); onMap(JSON.parse(e.data)); });
-  source.addEventListener('image', e => { count(); onImage(JSON.parse(e.data)); });
-  source.addEventListener('ground_truth', e => { count(); onTrajectory(JSON.parse(e.data), groundTruthLine); });
-  source.addEventListener('trajectory', e => {
-   count(); const m = JSON.parse(e.data); trajectory.length = 0; trajectory.push(...m.positions); onTrajectory(m, trajectoryLine);
+  if (source) source.close();
+  imageWidth = shownImageWidth();
+  source = new EventSource(imageShown() ? '/events?image_width=' + imageWidth : '/events?image=0');
+  source.addEventListener('frame', e => {
+   const f = JSON.parse(e.data);  // small; every pose goes into the trajectory
+   if (f.pose) trajectory.push(f.pose[0], f.pose[1], f.pose[2]);
+   pending.frame = f; count();
   });
-  source.addEventListener('reset', e => { count(); trajectory.length = 0; knownIds = new Set(); showStatus('map reset'); });
-  source.addEventListener('finish', e => { count(); body.dataset.finished = 'yes'; showStatus('run ' + JSON.parse(e.data).end_state); });
-  source.onerror = function () { showStatus('disconnected'); };
+  source.addEventListener('map', e => { pending.map = e.data; count(); });
+  source.addEventListener('image', e => { pending.image = e.data; count(); });
+  source.addEventListener('ground_truth', e => { pending.groundTruth = e.data; count(); });
+  source.addEventListener('trajectory', e => {
+   trajectory.length = 0; trajectory.push(...JSON.parse(e.data).positions); pending.trajectory = trajectory; count();
+  });
+  source.addEventListener('reset', e => { trajectory.length = 0; knownIds = new Set(); note = 'map reset'; count(); });
+  source.addEventListener('finish', e => { body.dataset.finished = 'yes'; note = 'run ' + JSON.parse(e.data).end_state; count(); });
+  source.onerror = function () { note = 'disconnected'; scheduleApply(); };
  }
  connect();
 
@@ -197,8 +252,9 @@ const std::string& viewer_page_html() {
  document.getElementById('pause').onclick = () => control('pause');
  document.getElementById('resume').onclick = () => control('resume');
  document.getElementById('step').onclick = () => control('step');
- document.getElementById('edges').onchange = e => { edgeLines.visible = loopLines.visible = e.target.checked; };
- document.getElementById('showimage').onchange = e => { document.getElementById('imagebox').style.display = e.target.checked ? '' : 'none'; };
+ document.getElementById('edges').onchange = e => { edgeLines.visible = loopLines.visible = e.target.checked; renderNextFrame(); };
+ document.getElementById('follow').onchange = () => scheduleApply();
+ document.getElementById('showimage').onchange = e => { imageBox.style.display = e.target.checked ? '' : 'none'; connect(); };
  // Tests: ?click=pause&after=N[&points=P] presses a button after N updates (and once P map points are shown).
  let clicked = false;
  function maybeClick() {
@@ -211,21 +267,10 @@ const std::string& viewer_page_html() {
  // Status back to the server once a second (GET /state shows it: tests and scripts read it there).
  setInterval(function () {
   fetch('/client', { method: 'POST', body: JSON.stringify({ updates: updates, errors: Number(body.dataset.errors),
-   webgl: body.dataset.webgl, renders: renders, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
+   webgl: body.dataset.webgl, software_gl: softwareGl, renders: renders, images: imagesDrawn, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
    paused: body.dataset.paused === 'true' }) }).catch(() => {});
  }, 1000);
- // Render only when something changed (software WebGL must not starve the event handlers).
- controls.addEventListener('change', () => { dirty = true; });
- function animate() {
-  requestAnimationFrame(animate);
-  if (!dirty || performance.now() - lastRender < 200) return;  // at most 5 renders a second
-  dirty = false;
-  if (params.get('norender')) return;
-  lastRender = performance.now();
-  renderer.render(scene, camera);
-  renders += 1; body.dataset.renders = String(renders);
- }
- animate();
+ render();
 })();
 </script>
 </body></html>

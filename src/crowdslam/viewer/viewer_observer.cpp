@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 namespace crowdslam::viewer {
 
 namespace {
@@ -88,8 +90,10 @@ void ViewerObserver::on_frame(const system::FrameReport& report, const std::opti
     s.paused = paused;
     push(std::move(s));
   }
+  // Images only for a page that shows them (encoding one costs the SLAM machine's CPU too).
   if (!images.colour.empty() &&
-      (paused || std::chrono::duration<double>(now - last_image_).count() >= options_.image_interval_s)) {
+      (paused || std::chrono::duration<double>(now - last_image_).count() >= options_.image_interval_s) &&
+      stream_.taken("image")) {
     last_image_ = now;
     push(ImageItem{report.index, images.colour.clone(), report.boxes, report.kept_keypoints, report.removed_keypoints});
   }
@@ -102,7 +106,8 @@ void ViewerObserver::on_reset(const system::MapSegment& segment) {
     std::lock_guard lock(mutex_);
     estimate_.clear();
   }
-  push(EventItem{"reset", nlohmann::json({{"map_id", segment.map_id}, {"last_frame", segment.last_frame}}).dump()});
+  push(EventItem{"reset", nlohmann::json({{"map_id", segment.map_id}, {"last_frame", segment.last_frame}}).dump(),
+                 false});
 }
 
 void ViewerObserver::on_map_snapshot(const std::shared_ptr<const system::MapSnapshot>& snapshot) { push(snapshot); }
@@ -133,8 +138,10 @@ void ViewerObserver::publish(Item& item) {
   if (auto* status = std::get_if<FrameStatus>(&item)) {
     stream_.publish("frame", frame_json(*status));
   } else if (auto* image = std::get_if<ImageItem>(&item)) {
-    stream_.publish("image", image_json(image->index, image->image, image->boxes, image->kept, image->removed,
-                                        options_.image_max_width));
+    // No wider than the widest page shows it (a small panel needs a quarter of the pixels).
+    const int wanted = stream_.image_width();
+    const int width = wanted > 0 ? std::min(wanted, options_.image_max_width) : options_.image_max_width;
+    stream_.publish("image", image_json(image->index, image->image, image->boxes, image->kept, image->removed, width));
   } else if (auto* snapshot = std::get_if<std::shared_ptr<const system::MapSnapshot>>(&item)) {
     stream_.publish("map", map_json(**snapshot));
     if (!options_.ground_truth.empty()) {
@@ -149,7 +156,7 @@ void ViewerObserver::publish(Item& item) {
       }
     }
   } else if (auto* event = std::get_if<EventItem>(&item)) {
-    stream_.publish(event->event, event->data);
+    stream_.publish(event->event, event->data, event->retain);
   }
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The live viewer's RunObserver: on the tracking thread it only copies what a message needs (decimated:
-// status at most every frame_interval_s, the image every image_interval_s, a map snapshot every
-// map_interval_s) into a small queue; its own thread serialises the JSON, encodes the JPEG, aligns the
+// status at most every frame_interval_s, the image every image_interval_s while a page takes images, a map
+// snapshot every map_interval_s) into a small queue; its own thread serialises the JSON, encodes the JPEG, aligns the
 // ground truth and publishes to the EventStream. The queue keeps at most a few items and drops the oldest,
 // so a slow browser or encoder never slows tracking.
 #include <condition_variable>
@@ -22,7 +22,7 @@ namespace crowdslam::viewer {
 
 struct ViewerObserverOptions {
   double frame_interval_s = 0.1;
-  double image_interval_s = 0.2;
+  double image_interval_s = 0.25;
   double map_interval_s = 1.0;
   int image_max_width = 640;
   size_t max_ground_truth_points = 3000;
@@ -60,6 +60,7 @@ class ViewerObserver : public system::RunObserver {
   struct EventItem {
     std::string event;
     std::string data;
+    bool retain = true;  // replayed to pages that connect later (a map reset is not)
   };
   using Item = std::variant<FrameStatus, ImageItem, std::shared_ptr<const system::MapSnapshot>, EventItem>;
   void push(Item item);

@@ -99,10 +99,17 @@ void ViewerServer::start() {
     client_report_ = req.body;
     res.set_content("{}", "application/json");
   });
-  s.Get("/events", [this](const httplib::Request&, httplib::Response& res) {
+  s.Get("/events", [this](const httplib::Request& req, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
     auto cursor = std::make_shared<EventStream::Cursor>();
-    res.set_chunked_content_provider("text/event-stream", [this, cursor](size_t, httplib::DataSink& sink) {
+    if (req.get_param_value("image") == "0") cursor->skip.insert("image");  // a page that hides its image
+    int image_width = 0;  // the width the page shows the image at (0: any)
+    const std::string width = req.get_param_value("image_width");
+    if (!width.empty() && width.size() < 6 && width.find_first_not_of("0123456789") == std::string::npos)
+      image_width = std::stoi(width);
+    // Counted as connected while the response (and so this provider) lives.
+    auto registration = stream_.register_client(cursor->skip, image_width);
+    res.set_chunked_content_provider("text/event-stream", [this, cursor, registration](size_t, httplib::DataSink& sink) {
       const auto messages = stream_.wait(*cursor, std::chrono::milliseconds(500));
       for (const auto& m : messages) {
         if (!sink.write(m->data(), m->size())) return false;  // the client went away

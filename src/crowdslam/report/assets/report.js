@@ -232,7 +232,7 @@
       return;
     }
     var node = section('Local mapping per keyframe', 'mapping',
-                       'Median and 95th percentile over the keyframes of each mapping step (run.json keeps these, not each keyframe\'s time).');
+                       'Median and 95th percentile over the keyframes of each mapping step, then each keyframe\'s time stacked by step, in the order the mapper processed them.');
     var datasets = [];
     runs.forEach(function (run, k) {
       if (!run.mapping) return;
@@ -241,6 +241,35 @@
     });
     addChart(node, '', { type: 'bar', data: { labels: withMapping[0].mapping.steps, datasets: datasets },
                          options: { scales: { y: { beginAtZero: true, title: { display: true, text: 'ms per keyframe' } } } } });
+    drawMappingPerKeyframe(node, withMapping.filter(function (run) { return run.mapping.keyframes; }));
+  }
+
+  // Each keyframe's mapping time, stacked by step (the rest of the total: removing bad points, the
+  // keyframe database); one stack per run.
+  function drawMappingPerKeyframe(node, withTimes) {
+    if (withTimes.length === 0) {
+      element('p', { class: 'note' }, node, 'No per-keyframe times (run.json written before they were recorded).');
+      return;
+    }
+    var steps = ['register', 'triangulation', 'fusion', 'local_ba', 'culling'];
+    var datasets = [];
+    runs.forEach(function (run, k) {
+      if (withTimes.indexOf(run) < 0) return;
+      var kf = run.mapping.keyframes;
+      var rest = kf.total.map(function (total, i) {
+        return Math.max(0, total - steps.reduce(function (sum, step) { return sum + kf[step][i]; }, 0));
+      });
+      steps.map(function (step) { return [step, kf[step]]; }).concat([['other', rest]]).forEach(function (series, j) {
+        var c = runs.length === 1 ? palette[j % palette.length] : colour(k);
+        var opacity = runs.length === 1 ? 0.6 : 0.15 + 0.12 * j;
+        datasets.push(line(run.label + ': ' + series[0], points(kf.n, series[1]), k,
+                           { stack: run.label, fill: j === 0 ? 'origin' : '-1', borderWidth: 0.6,
+                             borderColor: c, backgroundColor: faded(c, opacity) }));
+      });
+    });
+    addChart(node, 'tall', { type: 'line', data: { datasets: datasets },
+                             options: { scales: { x: axis('keyframe (in processing order)', { ticks: { precision: 0 } }),
+                                                  y: axis('ms', { stacked: true, beginAtZero: true }) } } });
   }
 
   // ---- people filter -------------------------------------------------------------------------
