@@ -62,6 +62,7 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"dynamic_grown", r.dynamic_grown},
           {"matches_moving", r.matches_moving},
           {"points_culled_moving", r.points_culled_moving},
+          {"dynamic_check_skipped", r.dynamic_check_skipped},
           {"stereo_matches", r.stereo_matches},
           {"right_keypoints_removed", r.right_keypoints_removed},
           {"right_wait_ms", r.right_wait_ms},
@@ -205,11 +206,13 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   int frames_waited = 0;
   long dynamic_total = 0, grown_total = 0, culled_total = 0;
   int frames_with_dynamic = 0;
+  int frames_check_skipped = 0;
   for (const auto& r : reports) {
     dynamic_total += r.keypoints_dynamic;
     grown_total += r.dynamic_grown;
     culled_total += r.points_culled_moving;
     frames_with_dynamic += r.keypoints_dynamic > 0 ? 1 : 0;
+    frames_check_skipped += r.dynamic_check_skipped ? 1 : 0;
     rescued += r.rescued_with_boxes ? 1 : 0;
     if (r.detector_ms > 0) detector_ms.push_back(r.detector_ms);  // latest mode: frames with a new detection
     detector_wait_ms.push_back(r.detector_wait_ms);
@@ -246,7 +249,8 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                      {"keypoints_dynamic", dynamic_total},
                      {"keypoints_grown", grown_total},
                      {"frames_with_dynamic", frames_with_dynamic},
-                     {"map_points_culled_moving", culled_total}};
+                     {"map_points_culled_moving", culled_total},
+                     {"frames_tracked_without_check", frames_check_skipped}};
   doc["summary"] = {{"frames", summary.frames},
                     {"tracked_frames", summary.tracked},
                     {"tracked_percent", summary.tracked_percent},

@@ -284,6 +284,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.dynamic_grown = result.dynamic.grown;
   report.matches_moving = result.dynamic.moving;
   report.points_culled_moving = result.dynamic.points_culled;
+  report.dynamic_check_skipped = result.dynamic.skipped;
   report.tracked_points = result.tracked_points;
 
   TrajectoryRecord record;

@@ -79,6 +79,7 @@ struct FrameReport {
   int dynamic_grown = 0;
   int matches_moving = 0;
   int points_culled_moving = 0;
+  bool dynamic_check_skipped = false;  // failed with the check, tracked without it
   int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
   // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).

@@ -52,7 +52,7 @@ void DynamicCheckOptions::check() const {
 DynamicCheck::DynamicCheck(const DynamicCheckOptions& options) : options_(options) { options_.check(); }
 
 void DynamicCheck::inherit(map::Frame& frame, const map::Frame* last) {
-  if (!options_.enabled) return;
+  if (!enabled()) return;
   const auto index = index_points(last);
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
@@ -73,7 +73,7 @@ void DynamicCheck::inherit(map::Frame& frame, const map::Frame* last) {
 }
 
 int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& pose_options) const {
-  if (!options_.enabled || options_.min_trusted <= 0 || !frame.cam_from_world) return 0;
+  if (!enabled() || options_.min_trusted <= 0 || !frame.cam_from_world) return 0;
   const auto& f = *frame.features;
   std::vector<optim::PoseObservation> trusted;
   size_t candidates = 0;
@@ -119,7 +119,7 @@ int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& p
 
 DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last) {
   DynamicCheckStats stats;
-  if (!options_.enabled || !frame.cam_from_world) return stats;
+  if (!enabled() || !frame.cam_from_world) return stats;
   const auto index = index_points(last);
   const auto& f = *frame.features;
   const geometry::SE3& pose = *frame.cam_from_world;

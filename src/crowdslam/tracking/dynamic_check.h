@@ -27,8 +27,9 @@ namespace crowdslam::tracking {
 struct DynamicCheckOptions {
   bool enabled = true;
   // A residual counts as motion above factor x the pose optimisation's chi-square threshold (5.991 with
-  // 2 dof, 7.815 with 3): chi2 > 2 x 7.815 happens to a static point with Gaussian noise 0.14 % of the time.
-  double moving_factor = 2.0;
+  // 2 dof, 7.815 with 3): chi2 > 4 x 7.815 (a 5.6 sigma error) is never noise. With 2 a synthetic crowd
+  // seen through lagging boxes lost track for good at frame 54 (docs/RESULTS.md).
+  double moving_factor = 4.0;
   // One observation alone makes a keypoint dynamic above this factor (0 = never: a wrong match can be
   // as far off as the search window, so by default motion must persist over two observations).
   double certain_factor = 0.0;
@@ -54,13 +55,16 @@ struct DynamicCheckStats {
   int dynamic = 0;         // keypoints dynamic after the check (region growth included)
   int grown = 0;           // of those, added by region growing
   int points_culled = 0;   // map points culled as moving
+  bool skipped = false;    // the frame failed with the check and was tracked without it (Tracker::track)
 };
 
 class DynamicCheck {
  public:
   explicit DynamicCheck(const DynamicCheckOptions& options);
 
-  [[nodiscard]] bool enabled() const { return options_.enabled; }
+  [[nodiscard]] bool enabled() const { return options_.enabled && !suspended_; }
+  // While suspended the check does nothing (Tracker::track's retry of a frame that failed with it).
+  void set_suspended(bool suspended) { suspended_ = suspended; }
 
   // Before a pose optimisation: marks as dynamic the frame's matches that are known to move (their map
   // point's score, or the last frame's keypoint they were matched through). `last` may be null.
@@ -79,6 +83,7 @@ class DynamicCheck {
   void grow_regions(map::Frame& frame, const std::vector<bool>& judged, DynamicCheckStats& stats) const;
 
   DynamicCheckOptions options_;
+  bool suspended_ = false;
 };
 
 }  // namespace crowdslam::tracking

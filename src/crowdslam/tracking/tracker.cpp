@@ -84,6 +84,9 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
     bool ok = false;
     const bool was_tracking = state_ == TrackingState::kOk && velocity_ && last_frame_;
     if (last_frame_) replace_replaced_points(*last_frame_);
+    // The dynamic check must never be the reason tracking fails: keep the frame as it came for a retry.
+    std::optional<map::Frame> untouched;
+    if (dynamic_check_.enabled() && was_tracking) untouched = frame;
     if (state_ == TrackingState::kOk && velocity_ && last_frame_) {
       ok = track_with_motion_model(frame);
       result.method = "motion";
@@ -98,6 +101,20 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
     }
     frame.reference_keyframe = reference_keyframe_;
     if (ok) ok = track_local_map(frame);
+    if (!ok && untouched && velocity_) {
+      dynamic_check_.set_suspended(true);
+      map::Frame again = std::move(*untouched);
+      if (track_with_motion_model(again)) {
+        again.reference_keyframe = reference_keyframe_;
+        if (track_local_map(again)) {
+          frame = std::move(again);
+          ok = true;
+          result.method = "motion";
+          result.dynamic.skipped = true;
+        }
+      }
+      dynamic_check_.set_suspended(false);
+    }
     if (!ok && was_tracking && unfiltered && velocity_) {
       if (auto features = unfiltered()) {
         map::Frame full(frame.id, frame.timestamp_s, frame.camera, frame.levels, std::move(features));
@@ -118,7 +135,9 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
     if (ok && dynamic_check_.enabled()) {
       // The pose is final: which of the matches moved (their map points may be culled), and the regions
       // around them. Dynamic keypoints are no longer tracked points.
+      const bool skipped = result.dynamic.skipped;
       result.dynamic = dynamic_check_.update(frame, last_frame_ ? &*last_frame_ : nullptr);
+      result.dynamic.skipped = skipped;
       inliers_in_local_map_ = count_tracked_in_map(frame);
     }
     if (ok) {
@@ -295,7 +314,18 @@ void Tracker::update_last_frame() {
 int Tracker::optimize_pose(map::Frame& frame) {
   // Matches known to move (dynamic_check.h) have no say in the pose.
   dynamic_check_.inherit(frame, last_frame_ ? &*last_frame_ : nullptr);
-  dynamic_check_.screen(frame, options_.pose);
+  const auto initial_pose = frame.cam_from_world;
+  const std::vector<bool> inherited = frame.dynamic;
+  if (dynamic_check_.screen(frame, options_.pose) == 0) return optimize_frame_pose(frame, options_.pose);
+  const std::vector<std::shared_ptr<map::MapPoint>> matches = frame.map_points;
+  const int inliers = optimize_frame_pose(frame, options_.pose);
+  if (inliers >= 50) return inliers;
+  // Too little agrees with the trusted points' pose (they may be the ones that moved): the ordinary
+  // optimisation from the initial guess decides instead.
+  frame.cam_from_world = initial_pose;
+  frame.dynamic = inherited;
+  frame.map_points = matches;
+  std::fill(frame.outliers.begin(), frame.outliers.end(), false);
   return optimize_frame_pose(frame, options_.pose);
 }
 
