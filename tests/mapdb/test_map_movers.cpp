@@ -1,8 +1,8 @@
 // The geometric dynamic check end to end (issue 16): a synthetic room with three moving objects that are
 // not people (a sliding crate, a swinging door, a turning cart) and no people filter. With the check the
-// movers have no say in the pose and the trajectory is more than twice as accurate (8.3 mm against
+// movers have no say in the pose and the trajectory is three times as accurate (5.5 mm against
 // 18.0 mm when this was written). Map points on the movers: the check does not yet keep them out of the
-// map (2.5 % of the map against 1.9 % without; issue 16's target is 1 %): points made from a mover's
+// map (2.6 % of the map against 1.9 % without; issue 16's target is 1 %): points made from a mover's
 // keypoints before they were ever judged, and no longer matched once it moved on, stay. Asserted: no
 // more than 5 %. Sequential runs (reproducible). Also `map info --masks`' counting.
 #include <gtest/gtest.h>

@@ -98,7 +98,7 @@ struct PeopleFilterSettings {
 
 // Geometric dynamic check of tracked keypoints against the static map (tracking/dynamic_check.h).
 struct GeometrySettings {
-  bool dynamic_check = true;
+  bool dynamic_check = false;  // opt-in for now: on, it makes ~40 % more keyframes and a two-lap loop test ran > 13 min
   double moving_factor = 4.0;    // residual chi2 above this x the 95 % threshold counts as motion
   double certain_factor = 0.0;   // one observation above this x makes a keypoint dynamic (0 = never)
   int dynamic_score = 2;         // map point motion score that makes its keypoints dynamic
