@@ -24,6 +24,35 @@ uint8_t push_verdict(uint8_t history, bool moving) {
   return static_cast<uint8_t>(bits | (n << 4));
 }
 
+// Keypoint i's error against its point seen from `pose`: reprojection plus, with depth, disparity, weighed
+// by the keypoint's level (chi2, 3 dof with depth, 2 without); a point behind the camera is far off.
+struct Residual {
+  double chi2 = 0;
+  double threshold = kChi2Mono;  // the 95 % chi-square threshold for its degrees of freedom
+};
+Residual residual(const map::Frame& frame, size_t i, const map::MapPoint& point, const geometry::SE3& pose) {
+  const auto& f = *frame.features;
+  const geometry::PinholeCamera& camera = *frame.camera;
+  const bool with_depth = f.has_right(i) && camera.is_stereo();
+  Residual r;
+  r.threshold = with_depth ? kChi2Stereo : kChi2Mono;
+  const geometry::Vec3 in_cam = pose * point.world();
+  if (in_cam.z() <= 0) {
+    r.chi2 = 1e9;
+    return r;
+  }
+  const geometry::Vec2 pixel = camera.project(in_cam);
+  const double du = f.keys_un[i].pt.x - pixel.x();
+  const double dv = f.keys_un[i].pt.y - pixel.y();
+  double e2 = du * du + dv * dv;
+  if (with_depth) {
+    const double dr = f.right_u[i] - (pixel.x() - camera.bf / in_cam.z());
+    e2 += dr * dr;
+  }
+  r.chi2 = e2 * frame.levels->inv_sigma2[f.keys_un[i].octave];
+  return r;
+}
+
 // Index of the last frame's keypoint matched to each of its points.
 std::unordered_map<const map::MapPoint*, size_t> index_points(const map::Frame* last) {
   std::unordered_map<const map::MapPoint*, size_t> index;
@@ -89,27 +118,12 @@ int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& p
   const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, trusted, pose_options);
   if (!result.success || result.num_inliers < options_.min_trusted) return 0;
   frame.cam_from_world = result.cam_from_world;
-  const geometry::PinholeCamera& camera = *frame.camera;
   int screened = 0;
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
     if (!p || frame.dynamic[i] || p->is_bad()) continue;
-    const geometry::Vec3 in_cam = result.cam_from_world * p->world();
-    const bool with_depth = f.has_right(i) && camera.is_stereo();
-    bool disagrees = in_cam.z() <= 0;
-    if (!disagrees) {
-      const geometry::Vec2 pixel = camera.project(in_cam);
-      const double du = f.keys_un[i].pt.x - pixel.x();
-      const double dv = f.keys_un[i].pt.y - pixel.y();
-      double e2 = du * du + dv * dv;
-      if (with_depth) {
-        const double dr = f.right_u[i] - (pixel.x() - camera.bf / in_cam.z());
-        e2 += dr * dr;
-      }
-      disagrees = e2 * frame.levels->inv_sigma2[f.keys_un[i].octave] >
-                  options_.moving_factor * (with_depth ? kChi2Stereo : kChi2Mono);
-    }
-    if (disagrees) {
+    const Residual r = residual(frame, i, *p, result.cam_from_world);
+    if (r.chi2 > options_.moving_factor * r.threshold) {
       frame.dynamic[i] = true;
       ++screened;
     }
@@ -121,9 +135,7 @@ DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last
   DynamicCheckStats stats;
   if (!enabled() || !frame.cam_from_world) return stats;
   const auto index = index_points(last);
-  const auto& f = *frame.features;
   const geometry::SE3& pose = *frame.cam_from_world;
-  const geometry::PinholeCamera& camera = *frame.camera;
   std::vector<bool> judged(frame.size(), false);
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
@@ -156,21 +168,9 @@ DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last
       frame.dynamic[i] = false;
       continue;
     }
-    const geometry::Vec3 in_cam = pose * p->world();
-    const bool with_depth = f.has_right(i) && camera.is_stereo();
-    double chi2 = 1e9;  // behind the camera: moving
-    if (in_cam.z() > 0) {
-      const geometry::Vec2 pixel = camera.project(in_cam);
-      const double du = f.keys_un[i].pt.x - pixel.x();
-      const double dv = f.keys_un[i].pt.y - pixel.y();
-      double e2 = du * du + dv * dv;
-      if (with_depth) {
-        const double dr = f.right_u[i] - (pixel.x() - camera.bf / in_cam.z());
-        e2 += dr * dr;
-      }
-      chi2 = e2 * frame.levels->inv_sigma2[f.keys_un[i].octave];
-    }
-    const double threshold = with_depth ? kChi2Stereo : kChi2Mono;
+    const Residual r = residual(frame, i, *p, pose);
+    const double chi2 = r.chi2;
+    const double threshold = r.threshold;
     const bool moving = chi2 > options_.moving_factor * threshold;
     const bool certain = options_.certain_factor > 0 && chi2 > options_.certain_factor * threshold;
     ++stats.checked;
