@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "crowdslam/synth/writer.h"
 #include "crowdslam/util/interrupt.h"
+#include "crowdslam/util/progress.h"
 
 namespace crowdslam::app {
 
@@ -41,7 +42,12 @@ void add_synth_command(CLI::App& app, GlobalOptions& global) {
   cmd->callback([args, &global] {
     args->options.trajectory = synth::parse_trajectory_kind(args->trajectory);
     InterruptScope interrupts;  // a signal stops the rendering and removes the unfinished output
-    const synth::SequenceSummary s = synth::write_sequence(args->options, args->out);
+    ProgressLine progress(!global.quiet, static_cast<size_t>(args->options.frames), "frame");
+    const synth::SequenceSummary s =
+        synth::write_sequence(args->options, args->out, [&progress](int done, int) {
+          progress.update(static_cast<size_t>(done), "");
+        });
+    progress.finish();
     if (global.json) {
       nlohmann::json j{{"out", args->out},
                        {"frames", s.frames},

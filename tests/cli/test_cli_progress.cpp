@@ -1,5 +1,5 @@
 // Progress of the long commands (issue 13): with stderr not a terminal (a pipe here), `run`, `detect` and
-// `vocab train` print plain progress lines (done/total, rate) every tenth of the work and a last one at
+// `vocab train` and `synth` print plain progress lines (done/total, rate) every tenth of the work and a last one at
 // the end, never redrawn in place; -q silences them. (On a terminal the same line is redrawn in place:
 // tests/util/test_progress.cpp covers ProgressLine itself.)
 #include <gtest/gtest.h>
@@ -96,4 +96,15 @@ TEST_F(CliProgress, VocabTrainPrintsPlainLinesForReadingAndEveryLevelAndQuietSil
   EXPECT_EQ(matches(err, "descriptor [0-9]+/[0-9]+ \\(100 %\\)[^\n]*k-means level 1/2"), 1u) << err;
   EXPECT_EQ(matches(err, "descriptor [0-9]+/[0-9]+ \\(100 %\\)[^\n]*k-means level 2/2"), 1u) << err;
   EXPECT_EQ(matches(silent, "image [0-9]+/30|descriptor [0-9]+/"), 0u) << silent;
+}
+
+TEST_F(CliProgress, SynthPrintsPlainLinesAndQuietSilencesThem) {
+  const std::vector<std::string> args = {"synth", "--frames", "30", "--width", "160", "--height", "120"};
+  auto plain = args, quiet = args;
+  plain.insert(plain.end(), {"--out", path("synth_plain").string()});
+  quiet.insert(quiet.end(), {"--out", path("synth_quiet").string()});
+  const auto [err, silent] = stderr_plain_and_quiet(plain, quiet);
+  expect_plain_lines(err, "frame");
+  EXPECT_EQ(matches(silent, "frame [0-9]+/30"), 0u) << silent;
+  EXPECT_TRUE(fs::exists(path("synth_quiet") / "rgb" / "000029.png"));
 }

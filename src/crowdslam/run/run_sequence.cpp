@@ -274,7 +274,8 @@ RunSummary run_sequence(const RunOptions& options) {
   summary.segments = slam.segments();
   summarise_frames(reports, summary);
   monitor.warn_totals();
-  if (p.sensor == io::SensorKind::kMonocular && !summary.init_frame && summary.frames > 0) {
+  if (p.sensor == io::SensorKind::kMonocular && !summary.init_frame && summary.frames > 0 &&
+      options.load_map.empty()) {  // a loaded map needs no initialisation
     spdlog::warn("{}: monocular map never initialised in {} frames (needs a textured scene and a camera that "
                  "translates, not only rotates)",
                  clip_text(options.dataset), summary.frames);

@@ -80,7 +80,8 @@ void prepare_output(const SynthOptions& options, const fs::path& out_dir) {
 
 class SequenceWriter {
  public:
-  SequenceWriter(const Scene& scene, fs::path dir) : scene_(scene), dir_(std::move(dir)) {}
+  SequenceWriter(const Scene& scene, fs::path dir, const FrameProgress& on_frame)
+      : scene_(scene), dir_(std::move(dir)), on_frame_(on_frame) {}
 
   std::vector<FrameResult> write_frames() {
     const SynthOptions& o = scene_.options();
@@ -105,6 +106,10 @@ class SequenceWriter {
       try {
         throw_if_interrupted();  // `crowdslam synth` inside an InterruptScope
         write_frame(frame);
+        if (on_frame_) {
+          const std::lock_guard<std::mutex> lock(mutex_);
+          on_frame_(++done_, scene_.frame_count());
+        }
       } catch (...) {
         const std::lock_guard<std::mutex> lock(mutex_);
         if (!error_) error_ = std::current_exception();
@@ -130,11 +135,12 @@ class SequenceWriter {
     FrameResult& result = results_[frame];
     result.boxes = visible_person_boxes(scene_, left, world_from_cam, frame);
     result.coverage = static_cast<double>(cv::countNonZero(left.person_label)) / left.person_label.total();
-    if (frame % 100 == 0) spdlog::debug("synth: frame {}/{}", frame, scene_.frame_count());
   }
 
   const Scene& scene_;
   fs::path dir_;
+  const FrameProgress& on_frame_;
+  int done_ = 0;  // frames written (under mutex_)
   std::vector<FrameResult> results_;
   std::atomic<int> next_{0};
   std::atomic<bool> failed_{false};
@@ -284,7 +290,7 @@ std::string settings_yaml(const SynthOptions& o) {
   return out.str();
 }
 
-SequenceSummary write_sequence(const SynthOptions& options, const fs::path& out_dir_arg) {
+SequenceSummary write_sequence(const SynthOptions& options, const fs::path& out_dir_arg, const FrameProgress& on_frame) {
   const auto start = std::chrono::steady_clock::now();
   options.check();
   fs::path out_dir = out_dir_arg;
@@ -306,7 +312,7 @@ SequenceSummary write_sequence(const SynthOptions& options, const fs::path& out_
       spdlog::warn("synth: no photographs in '{}' (install opencv-doc); using procedural textures",
                    options.texture_dir);
     }
-    const std::vector<FrameResult> results = SequenceWriter(scene, tmp).write_frames();
+    const std::vector<FrameResult> results = SequenceWriter(scene, tmp, on_frame).write_frames();
     SequenceSummary summary = summarise(scene, results);
     write_text_files(scene, tmp, results, summary);
     if (fs::exists(out_dir, ec)) fs::remove_all(out_dir);

@@ -17,6 +17,7 @@
 // The output appears atomically: everything is written into "<out_dir>.tmp-<pid>" which is renamed to
 // out_dir at the end; an existing non-empty out_dir is an error unless options.force.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,11 @@ struct SequenceSummary {
   bool photo_textures = false;
 };
 
-SequenceSummary write_sequence(const SynthOptions& options, const std::filesystem::path& out_dir);
+// `on_frame(done, total)` (optional) is called after each written frame, from the rendering threads one
+// at a time, with the number of frames finished so far.
+using FrameProgress = std::function<void(int done, int total)>;
+SequenceSummary write_sequence(const SynthOptions& options, const std::filesystem::path& out_dir,
+                               const FrameProgress& on_frame = {});
 
 // The MOT lines (without frame-independent parts) for one rendered frame: visible people and their boxes.
 struct PersonBox {
