@@ -2,14 +2,19 @@
 # Throughput with the live viewer (issue 13): N runs without --viewer and N with --viewer and a headless
 # Chromium connected to it (on this same machine), alternating; prints each run, the browser's CPU time
 # by process and thread (scripts/lib/process_cpu.py) and the medians.
-#   scripts/measure_viewer.sh [-p PAGE_QUERY] [-n RUNS] [-b BUILD_DIR] -- RUN_ARGS...
+#   scripts/measure_viewer.sh [-w] [-p PAGE_QUERY] [-n RUNS] [-b BUILD_DIR] -- RUN_ARGS...
 # PAGE_QUERY (diagnostics) is appended to the page's URL, e.g. -p norender=1.
+# -w: a warm browser, as a user who has one open: Chromium starts before the run on a local page that
+# opens the viewer as soon as the server answers, and its CPU counts from the run's start (without -w
+# the browser starts with the run, and its start-up, about 2.7 CPU seconds, falls inside the run).
 # Example: scripts/measure_viewer.sh -n 3 -- --dataset ../shared/data/bonn_crowd --settings config/Bonn.yaml
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=3
 script=measure_viewer
 query=
+warm=0
+if [[ "${1:-}" == "-w" ]]; then warm=1; shift; fi
 if [[ "${1:-}" == "-p" ]]; then query="?$2"; shift 2; fi
 source scripts/lib/run_options.sh
 parse_run_options "$@"
@@ -19,14 +24,30 @@ mkdir -p "$out"
 port=8765
 for ((k = 1; k <= runs; ++k)); do
   "$bin" -q run "${run_args[@]}" --out "$out/plain_$k" >/dev/null
+  chromium_args=(--headless=new --no-sandbox --disable-gpu --enable-unsafe-swiftshader --use-angle=swiftshader
+    --no-first-run --remote-debugging-port=0 --user-data-dir="$out/profile_$k")
+  url="http://127.0.0.1:$port/$query"
+  if ((warm)); then
+    # A local page that polls the port and opens the viewer once the run's server answers.
+    cat >"$out/wait.html" <<HTML
+<!doctype html><script>
+setInterval(() => fetch('http://127.0.0.1:$port/', {mode: 'no-cors'}).then(() => { location.href = '$url'; }, () => {}), 100);
+</script>
+HTML
+    timeout 600 chromium "${chromium_args[@]}" "file://$PWD/$out/wait.html" >/dev/null 2>&1 &
+    browser=$!
+    sleep 5  # start-up done, the browser idles on the waiting page
+  fi
   "$bin" -q run "${run_args[@]}" --out "$out/viewer_$k" --viewer --viewer-port "$port" >/dev/null 2>"$out/viewer_$k.log" &
   pid=$!
-  sleep 0.5
-  timeout 600 chromium --headless=new --no-sandbox --disable-gpu --enable-unsafe-swiftshader --use-angle=swiftshader \
-    --no-first-run --remote-debugging-port=0 --user-data-dir="$out/profile_$k" "http://127.0.0.1:$port/$query" \
-    >/dev/null 2>&1 &
-  browser=$!
-  /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" &
+  if ((warm)); then
+    /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" --since-start &
+  else
+    sleep 0.5
+    timeout 600 chromium "${chromium_args[@]}" "$url" >/dev/null 2>&1 &
+    browser=$!
+    /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" &
+  fi
   sampler=$!
   wait "$pid"
   kill "$sampler" 2>/dev/null || true

@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 """CPU time of a process tree, by process type and thread name (scripts/measure_viewer.sh).
 
-    process_cpu.py ROOT_PID OUT_JSON
+    process_cpu.py ROOT_PID OUT_JSON [--since-start]
 
-Samples /proc every 0.2 s until ROOT_PID exits or SIGTERM arrives, keeping the newest CPU time of every
+With --since-start, the CPU time the tree had used when sampling began is left out (a browser started
+earlier counts only from then on). Samples /proc every 0.2 s until ROOT_PID exits or SIGTERM arrives, keeping the newest CPU time of every
 thread of ROOT_PID and its descendants (threads and processes that ended keep their last sample), then
 writes {"total_s": ..., "by_type": {...}, "by_thread": {"type/thread name": seconds}} to OUT_JSON.
 The type is Chromium's --type=... (renderer, gpu-process, utility; "browser" without one).
@@ -56,6 +57,9 @@ def descendants(root):
 
 def main():
     root, out_path = int(sys.argv[1]), sys.argv[2]
+    since_start = "--since-start" in sys.argv[3:]
+    base = {}  # (pid, tid) -> seconds at the first sample (--since-start)
+    first = True
     stop = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     seen = {}  # (pid, tid) -> (type, thread name, seconds)
@@ -69,7 +73,11 @@ def main():
             for tid in tids:
                 comm, fields = stat_fields(read(f"/proc/{pid}/task/{tid}/stat"))
                 if len(fields) > 13:
-                    seen[(pid, tid)] = (kind, comm, (int(fields[11]) + int(fields[12])) / TICK)
+                    seconds = (int(fields[11]) + int(fields[12])) / TICK
+                    if first and since_start:
+                        base[(pid, tid)] = seconds
+                    seen[(pid, tid)] = (kind, comm, seconds - base.get((pid, tid), 0.0))
+        first = False
         time.sleep(0.2)
     by_type, by_thread = {}, {}
     for kind, comm, seconds in seen.values():
