@@ -77,8 +77,9 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("--box-tracker", args->options.box_tracker,
                   "on: boxes persist through missed detections and one-detection boxes are dropped (Detector.tracker)");
   cmd->add_option("--geometry", args->options.geometry,
-                  "on: keypoints and map points that move against the estimated camera motion are kept out of "
-                  "tracking and mapping, with or without the people filter (Geometry.dynamic_check)");
+                  "on (default): keypoints and map points that move against the estimated camera motion are kept "
+                  "out of tracking and mapping, with or without the people filter; off: the check is skipped "
+                  "(Geometry.dynamic_check)");
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
   cmd->add_option("--vocabulary", args->options.vocabulary,

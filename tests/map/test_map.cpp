@@ -119,6 +119,22 @@ TEST(Covisibility, WeakOnlyNeighbourStillConnected) {
   EXPECT_EQ(b->parent()->id, a->id);
 }
 
+TEST(MapPoint, MotionScoreCountsMovingVerdictsAmongTheLastEight) {
+  map::MapPoint p(0, geometry::Vec3(0, 0, 1), nullptr, 0);
+  EXPECT_EQ(p.motion_score(), 0);
+  // A static point judged moving once in every four observations, for a long time: never above 2.
+  int highest = 0;
+  for (int k = 0; k < 200; ++k) highest = std::max(highest, p.record_motion(k % 4 == 0));
+  EXPECT_EQ(highest, 2);
+  // A point that starts to move: one more moving verdict per observation until all 8 are.
+  std::vector<int> scores;
+  for (int k = 0; k < 9; ++k) scores.push_back(p.record_motion(true));
+  EXPECT_EQ(scores.back(), 8);
+  EXPECT_EQ(p.record_motion(true), 8);  // at most the window
+  // And stops: each static verdict pushes one moving verdict out.
+  for (int k = 1; k <= 8; ++k) EXPECT_EQ(p.record_motion(false), 8 - k);
+}
+
 TEST(MapPoint, StereoObservationsCountTwiceAndPointDiesWithFewObservations) {
   TestMap t;
   auto a = t.add_keyframe(), b = t.add_keyframe(), c = t.add_keyframe();

@@ -131,7 +131,7 @@ TEST(DynamicCheck, MovingPointIsDynamicWithinThreeFramesAndCulled) {
   std::vector<int> first_dynamic(n_moving, -1);
   // A far point's first 3 cm (3 px at 5 m) are within noise; the map point stays where it was seen, so
   // the residual grows with every frame.
-  for (int frame_id = 1; frame_id <= 4; ++frame_id) {
+  for (int frame_id = 1; frame_id <= 9; ++frame_id) {
     for (size_t m = 0; m < n_moving; ++m) observed[n_static + m].cam.x() += 0.03;  // the world point moved
     map::Frame frame = make_frame(static_cast<uint64_t>(frame_id), observed, points, rng);
     check.inherit(frame, last ? &*last : nullptr);
@@ -145,7 +145,7 @@ TEST(DynamicCheck, MovingPointIsDynamicWithinThreeFramesAndCulled) {
   for (size_t m = 0; m < n_moving; ++m) {
     EXPECT_GE(first_dynamic[m], 1) << "moving point " << m << " never marked dynamic";
     EXPECT_LE(first_dynamic[m], 3);
-    EXPECT_TRUE(points[n_static + m]->is_bad()) << "seen moving three times in four frames: culled";
+    EXPECT_TRUE(points[n_static + m]->is_bad()) << "seen moving in all eight checked frames: culled";
   }
   int static_culled = 0;
   for (size_t i = 0; i < n_static; ++i) static_culled += points[i]->is_bad() ? 1 : 0;
@@ -157,8 +157,14 @@ TEST(DynamicCheck, InheritExcludesKnownMovingMatchesBeforeThePose) {
   auto kf = keyframe(2);
   std::vector<Observed> observed{{{0.2, 0.1, 2.0}, 0}, {{-0.3, 0.0, 3.0}, 0}};
   std::vector<std::shared_ptr<map::MapPoint>> points{map_point(0, observed[0].cam, kf), map_point(1, observed[1].cam, kf)};
-  points[1]->record_motion(true);
-  points[1]->record_motion(true);  // score 2: dynamic
+  points[1]->record_motion(false);
+  for (int k = 0; k < 7; ++k) points[1]->record_motion(true);
+  EXPECT_EQ(points[1]->motion_score(), 7);  // 7 of the last 8: not yet
+  DynamicCheck early{DynamicCheckOptions{}};
+  map::Frame before = make_frame(1, observed, points, rng);
+  early.inherit(before, nullptr);
+  EXPECT_FALSE(before.dynamic[1]);
+  points[1]->record_motion(true);  // all of the last 8: dynamic
   DynamicCheck check{DynamicCheckOptions{}};
   map::Frame frame = make_frame(1, observed, points, rng);
   check.inherit(frame, nullptr);
@@ -245,7 +251,10 @@ TEST(DynamicCheck, BadOptionsAreInputErrors) {
   o.moving_factor = 0;
   EXPECT_THROW(DynamicCheck{o}, InputError);
   o = {};
-  o.cull_score = 1;  // below dynamic_score 2
+  o.cull_score = 1;  // below dynamic_score 8
+  EXPECT_THROW(DynamicCheck{o}, InputError);
+  o = {};
+  o.cull_score = 9;  // more verdicts than a map point keeps (8)
   EXPECT_THROW(DynamicCheck{o}, InputError);
   o = {};
   o.certain_factor = 1.0;  // below moving_factor

@@ -98,11 +98,11 @@ struct PeopleFilterSettings {
 
 // Geometric dynamic check of tracked keypoints against the static map (tracking/dynamic_check.h).
 struct GeometrySettings {
-  bool dynamic_check = false;  // opt-in for now: on, it makes ~40 % more keyframes and a two-lap loop test ran > 13 min
+  bool dynamic_check = true;  // off: --geometry off or Geometry.dynamic_check: 0
   double moving_factor = 4.0;    // residual chi2 above this x the 95 % threshold counts as motion
   double certain_factor = 0.0;   // one observation above this x makes a keypoint dynamic (0 = never)
-  int dynamic_score = 2;         // map point motion score that makes its keypoints dynamic
-  int cull_score = 3;            // map point motion score at which it is culled
+  int dynamic_score = 8;         // moving verdicts among a map point's last 8 that make its keypoints dynamic
+  int cull_score = 8;            // moving verdicts among its last 8 at which it is culled
   double region_radius_px = 20.0;  // region growing radius at 640 px width
   double region_depth_m = 0.15;    // region growing depth tolerance (or region_depth_ratio x depth)
   double region_depth_ratio = 0.08;

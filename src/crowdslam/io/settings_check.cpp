@@ -196,7 +196,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(g.certain_factor) && (g.certain_factor == 0 || g.certain_factor >= g.moving_factor),
             "Geometry.certain_factor", "0 (off) or >= Geometry.moving_factor", g.certain_factor);
   c.require(g.dynamic_score >= 1, "Geometry.dynamic_score", ">= 1", g.dynamic_score);
-  c.require(g.cull_score >= g.dynamic_score, "Geometry.cull_score", ">= Geometry.dynamic_score", g.cull_score);
+  c.require(g.cull_score >= g.dynamic_score && g.cull_score <= 8, "Geometry.cull_score",
+            ">= Geometry.dynamic_score and <= 8 (verdicts among a map point's last 8)", g.cull_score);
   c.require(std::isfinite(g.region_radius_px) && g.region_radius_px >= 0, "Geometry.region_radius_px", ">= 0",
             g.region_radius_px);
   c.require(std::isfinite(g.region_depth_m) && g.region_depth_m >= 0, "Geometry.region_depth_m", ">= 0",

@@ -196,13 +196,14 @@ void MapPoint::increase_found(int n) {
 
 int MapPoint::record_motion(bool moving) {
   std::lock_guard lock(features_mutex_);
-  motion_score_ = moving ? motion_score_ + 1 : std::max(0, motion_score_ - 1);
-  return motion_score_;
+  static_assert(kMotionWindow == 8, "motion_bits_ holds 8 verdicts");
+  motion_bits_ = static_cast<uint8_t>((motion_bits_ << 1) | (moving ? 1 : 0));
+  return __builtin_popcount(motion_bits_);
 }
 
 int MapPoint::motion_score() const {
   std::lock_guard lock(features_mutex_);
-  return motion_score_;
+  return __builtin_popcount(motion_bits_);
 }
 
 float MapPoint::found_ratio() const {

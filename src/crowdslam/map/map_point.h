@@ -62,9 +62,13 @@ class MapPoint {
   [[nodiscard]] float found_ratio() const;
   [[nodiscard]] int visible_count() const;
   [[nodiscard]] int found_count() const;
-  // Geometric dynamic check (tracking/dynamic_check.h): the evidence that the point moves. Each
-  // observation judged moving adds one, each judged static takes one off (never below 0); returns the
-  // new score. A point with a score >= 2 is treated as dynamic.
+  // Geometric dynamic check (tracking/dynamic_check.h): the evidence that the point moves, as the verdicts
+  // of its last kMotionWindow checked observations. record_motion adds one verdict and returns the new
+  // score, the number of those verdicts that said "moving". A window, not a running sum: a static point
+  // whose matches are now and then off (a wrong match, a depth edge) collects a moving verdict every few
+  // observations, and a sum that only decays by one per static verdict reached any small threshold
+  // sooner or later (on bonn_crowd it made static points dynamic and doubled the keyframes).
+  static constexpr int kMotionWindow = 8;
   int record_motion(bool moving);
   [[nodiscard]] int motion_score() const;
 
@@ -100,7 +104,7 @@ class MapPoint {
   Descriptor descriptor_{};
   int visible_ = 1;
   int found_ = 1;
-  int motion_score_ = 0;
+  uint8_t motion_bits_ = 0;  // the last kMotionWindow verdicts, newest in bit 0 (1 = moving)
   bool bad_ = false;
   std::weak_ptr<MapPoint> replaced_by_;
 };

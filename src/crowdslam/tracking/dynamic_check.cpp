@@ -70,8 +70,8 @@ void DynamicCheckOptions::check() const {
   if (!(moving_factor > 0) || !(certain_factor == 0 || certain_factor >= moving_factor)) {
     throw InputError("Geometry: moving_factor must be > 0 and certain_factor 0 or >= moving_factor");
   }
-  if (dynamic_score < 1 || cull_score < dynamic_score) {
-    throw InputError("Geometry: dynamic_score must be >= 1 and cull_score >= dynamic_score");
+  if (dynamic_score < 1 || cull_score < dynamic_score || cull_score > map::MapPoint::kMotionWindow) {
+    throw InputError("Geometry: dynamic_score must be >= 1 and cull_score >= dynamic_score and <= 8");
   }
   if (!(region_radius_px >= 0) || !(region_depth_m >= 0) || !(region_depth_ratio >= 0) || region_steps < 0) {
     throw InputError("Geometry: region_radius_px, region_depth_m, region_depth_ratio and region_steps must be >= 0");
@@ -110,7 +110,7 @@ int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& p
     const auto& p = frame.map_points[i];
     if (!p || frame.dynamic[i] || p->is_bad()) continue;
     ++candidates;
-    if (p->num_observations() < options_.trusted_observations || p->motion_score() > 0) continue;
+    if (p->num_observations() < options_.trusted_observations || p->motion_score() > 1) continue;
     trusted.push_back({p->world(), geometry::Vec2(f.keys_un[i].pt.x, f.keys_un[i].pt.y), f.right_u[i],
                        frame.levels->inv_sigma2[f.keys_un[i].octave]});
   }

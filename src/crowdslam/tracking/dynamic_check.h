@@ -7,14 +7,15 @@
 //
 // A single bad residual may be a wrong match; motion is what persists. Each keypoint carries the verdicts
 // of its last three checked observations from frame to frame along its matches (Frame::motion_history),
-// and each map point a motion score (MapPoint::record_motion). A keypoint is dynamic when two of its last
-// three observations moved (or, optionally, a single one by far), or when its map point's score says so. Dynamic keypoints then grow into regions: unmatched keypoints next to a
-// dynamic one in the image, at a similar depth when both have one, are dynamic too (up to two steps),
-// so that a moving object's unmatched keypoints go with it.
+// and each map point the verdicts of its last 8 checked observations (MapPoint::record_motion). A
+// keypoint is dynamic when two of its last three observations moved (or, optionally, a single one by
+// far), or when all of its map point's last 8 did (dynamic_score). Dynamic keypoints then grow into
+// regions: unmatched keypoints next to a dynamic one in the image, at a similar depth when both have one,
+// are dynamic too (up to two steps), so that a moving object's unmatched keypoints go with it.
 //
 // What dynamic means for the rest of tracking: no say in the pose (pose_refinement skips them), no new
 // map points (Tracker::create_new_keyframe leaves them out of the keyframe), and a map point seen moving
-// repeatedly (score >= cull_score) is culled from the map.
+// repeatedly (in all of its last 8 checked observations, cull_score) is culled from the map.
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -33,8 +34,8 @@ struct DynamicCheckOptions {
   // One observation alone makes a keypoint dynamic above this factor (0 = never: a wrong match can be
   // as far off as the search window, so by default motion must persist over two observations).
   double certain_factor = 0.0;
-  int dynamic_score = 2;  // map point motion score that makes its keypoints dynamic (and excluded)
-  int cull_score = 3;     // map point motion score at which the point is culled
+  int dynamic_score = 8;  // moving verdicts among a map point's last 8 that make its keypoints dynamic (and excluded)
+  int cull_score = 8;     // moving verdicts among its last 8 at which the point is culled
   // Region growing, in pixels at 640 px image width (scaled with the width): radius around a dynamic
   // keypoint, and depth similarity (|dz| <= max(region_depth_m, region_depth_ratio * z)).
   double region_radius_px = 20.0;
@@ -42,7 +43,7 @@ struct DynamicCheckOptions {
   double region_depth_ratio = 0.08;
   int region_steps = 2;
   // Static-first pose: when at least min_trusted matches are trusted (map points seen this often, counting
-  // a depth observation twice, never judged moving), the pose is first estimated from them alone and the
+  // a depth observation twice, judged moving at most once in its last 8), the pose is first estimated from them alone and the
   // other matches that disagree with it are left out of the full optimisation (0 = off).
   int trusted_observations = 6;
   int min_trusted = 30;
