@@ -53,6 +53,24 @@ Residual residual(const map::Frame& frame, size_t i, const map::MapPoint& point,
   return r;
 }
 
+// The frame's residual scale: the median of its matches' chi2, each divided by the median of its
+// chi-square distribution (1.386 with 2 dof, 2.366 with 3), at least 1. With residuals as the keypoint
+// levels predict it is about 1; with noisier depth or map points made from it (a 5 cm depth noise makes
+// every disparity residual large) it grows, and "moving" then means far off by this frame's own noise,
+// not by an assumed one. The median ignores the moving minority.
+double residual_scale(const map::Frame& frame, const std::vector<size_t>& slots, const geometry::SE3& pose) {
+  std::vector<double> ratios;
+  ratios.reserve(slots.size());
+  for (const size_t i : slots) {
+    const Residual r = residual(frame, i, *frame.map_points[i], pose);
+    ratios.push_back(r.chi2 / (r.threshold == kChi2Stereo ? 2.366 : 1.386));
+  }
+  if (ratios.size() < 20) return 1.0;  // too few for a median that means anything
+  auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+  std::nth_element(ratios.begin(), mid, ratios.end());
+  return std::max(1.0, *mid);
+}
+
 // Index of the last frame's keypoint matched to each of its points.
 std::unordered_map<const map::MapPoint*, size_t> index_points(const map::Frame* last) {
   std::unordered_map<const map::MapPoint*, size_t> index;
@@ -118,12 +136,16 @@ int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& p
   const auto result = optim::optimize_pose(*frame.camera, *frame.cam_from_world, trusted, pose_options);
   if (!result.success || result.num_inliers < options_.min_trusted) return 0;
   frame.cam_from_world = result.cam_from_world;
-  int screened = 0;
+  std::vector<size_t> slots;
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || frame.dynamic[i] || p->is_bad()) continue;
-    const Residual r = residual(frame, i, *p, result.cam_from_world);
-    if (r.chi2 > options_.moving_factor * r.threshold) {
+    if (p && !frame.dynamic[i] && !p->is_bad()) slots.push_back(i);
+  }
+  const double scale = residual_scale(frame, slots, result.cam_from_world);
+  int screened = 0;
+  for (const size_t i : slots) {
+    const Residual r = residual(frame, i, *frame.map_points[i], result.cam_from_world);
+    if (r.chi2 > options_.moving_factor * r.threshold * scale) {
       frame.dynamic[i] = true;
       ++screened;
     }
@@ -137,6 +159,13 @@ DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last
   const auto index = index_points(last);
   const geometry::SE3& pose = *frame.cam_from_world;
   std::vector<bool> judged(frame.size(), false);
+  std::vector<size_t> carried;  // the matches that get a verdict: carried from the last frame
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (p && !p->is_bad() && index.count(p.get())) carried.push_back(i);
+  }
+  const double scale = residual_scale(frame, carried, pose);
+  stats.residual_scale = scale;
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
     if (!p) {
@@ -171,8 +200,8 @@ DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last
     const Residual r = residual(frame, i, *p, pose);
     const double chi2 = r.chi2;
     const double threshold = r.threshold;
-    const bool moving = chi2 > options_.moving_factor * threshold;
-    const bool certain = options_.certain_factor > 0 && chi2 > options_.certain_factor * threshold;
+    const bool moving = chi2 > options_.moving_factor * threshold * scale;
+    const bool certain = options_.certain_factor > 0 && chi2 > options_.certain_factor * threshold * scale;
     ++stats.checked;
     if (moving) ++stats.moving;
     history = push_verdict(history, moving);

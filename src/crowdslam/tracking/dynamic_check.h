@@ -3,7 +3,8 @@
 // every keypoint matched to a map point or to a keypoint of the last frame (the visual-odometry points of
 // RGB-D/stereo) is tested against that pose: its reprojection error and, with depth, its disparity error,
 // weighed by the keypoint's pyramid level, as the pose optimisation's chi-square test (2 dof monocular,
-// 3 dof with depth) but at a stricter threshold so that noise does not count as motion.
+// 3 dof with depth) but at a stricter threshold so that noise does not count as motion, and scaled by the
+// frame's own median residual when that is larger than the levels predict (noisy depth).
 //
 // A single bad residual may be a wrong match; motion is what persists. Each keypoint carries the verdicts
 // of its last three checked observations from frame to frame along its matches (Frame::motion_history),
@@ -57,6 +58,7 @@ struct DynamicCheckStats {
   int grown = 0;           // of those, added by region growing
   int points_culled = 0;   // map points culled as moving
   bool skipped = false;    // the frame failed with the check and was tracked without it (Tracker::track)
+  double residual_scale = 1;  // this frame's residual scale (>= 1): thresholds are multiplied by it
 };
 
 class DynamicCheck {
