@@ -58,14 +58,11 @@ Residual residual(const map::Frame& frame, size_t i, const map::MapPoint& point,
 // levels predict it is about 1; with noisier depth or map points made from it (a 5 cm depth noise makes
 // every disparity residual large) it grows, and "moving" then means far off by this frame's own noise,
 // not by an assumed one. The median ignores the moving minority.
-double residual_scale(const map::Frame& frame, const std::vector<size_t>& slots, const geometry::SE3& pose) {
+double residual_scale(const std::vector<Residual>& residuals) {
+  if (residuals.size() < 20) return 1.0;  // too few for a median that means anything
   std::vector<double> ratios;
-  ratios.reserve(slots.size());
-  for (const size_t i : slots) {
-    const Residual r = residual(frame, i, *frame.map_points[i], pose);
-    ratios.push_back(r.chi2 / (r.threshold == kChi2Stereo ? 2.366 : 1.386));
-  }
-  if (ratios.size() < 20) return 1.0;  // too few for a median that means anything
+  ratios.reserve(residuals.size());
+  for (const Residual& r : residuals) ratios.push_back(r.chi2 / (r.threshold == kChi2Stereo ? 2.366 : 1.386));
   auto mid = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
   std::nth_element(ratios.begin(), mid, ratios.end());
   return std::max(1.0, *mid);
@@ -137,16 +134,18 @@ int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& p
   if (!result.success || result.num_inliers < options_.min_trusted) return 0;
   frame.cam_from_world = result.cam_from_world;
   std::vector<size_t> slots;
+  std::vector<Residual> residuals;
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (p && !frame.dynamic[i] && !p->is_bad()) slots.push_back(i);
+    if (!p || frame.dynamic[i] || p->is_bad()) continue;
+    slots.push_back(i);
+    residuals.push_back(residual(frame, i, *p, result.cam_from_world));
   }
-  const double scale = residual_scale(frame, slots, result.cam_from_world);
+  const double scale = residual_scale(residuals);
   int screened = 0;
-  for (const size_t i : slots) {
-    const Residual r = residual(frame, i, *frame.map_points[i], result.cam_from_world);
-    if (r.chi2 > options_.moving_factor * r.threshold * scale) {
-      frame.dynamic[i] = true;
+  for (size_t k = 0; k < slots.size(); ++k) {
+    if (residuals[k].chi2 > options_.moving_factor * residuals[k].threshold * scale) {
+      frame.dynamic[slots[k]] = true;
       ++screened;
     }
   }
@@ -159,13 +158,17 @@ DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last
   const auto index = index_points(last);
   const geometry::SE3& pose = *frame.cam_from_world;
   std::vector<bool> judged(frame.size(), false);
-  std::vector<size_t> carried;  // the matches that get a verdict: carried from the last frame
+  // The residuals of the matches that get a verdict (carried from the last frame), computed once: they
+  // set the frame's residual scale and then the verdicts.
+  std::vector<Residual> residuals(frame.size());
+  std::vector<Residual> carried;
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (p && !p->is_bad() && index.count(p.get())) carried.push_back(i);
+    if (!p || p->is_bad() || !index.count(p.get())) continue;
+    residuals[i] = residual(frame, i, *p, pose);
+    carried.push_back(residuals[i]);
   }
-  const double scale = residual_scale(frame, carried, pose);
-  stats.residual_scale = scale;
+  const double scale = residual_scale(carried);
   for (size_t i = 0; i < frame.size(); ++i) {
     const auto& p = frame.map_points[i];
     if (!p) {
@@ -197,9 +200,8 @@ DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last
       frame.dynamic[i] = false;
       continue;
     }
-    const Residual r = residual(frame, i, *p, pose);
-    const double chi2 = r.chi2;
-    const double threshold = r.threshold;
+    const double chi2 = residuals[i].chi2;
+    const double threshold = residuals[i].threshold;
     const bool moving = chi2 > options_.moving_factor * threshold * scale;
     const bool certain = options_.certain_factor > 0 && chi2 > options_.certain_factor * threshold * scale;
     ++stats.checked;

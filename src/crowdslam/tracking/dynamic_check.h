@@ -58,7 +58,6 @@ struct DynamicCheckStats {
   int grown = 0;           // of those, added by region growing
   int points_culled = 0;   // map points culled as moving
   bool skipped = false;    // the frame failed with the check and was tracked without it (Tracker::track)
-  double residual_scale = 1;  // this frame's residual scale (>= 1): thresholds are multiplied by it
 };
 
 class DynamicCheck {
