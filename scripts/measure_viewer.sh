@@ -4,9 +4,10 @@
 # by process and thread (scripts/lib/process_cpu.py) and the medians.
 #   scripts/measure_viewer.sh [-w] [-p PAGE_QUERY] [-n RUNS] [-b BUILD_DIR] -- RUN_ARGS...
 # PAGE_QUERY (diagnostics) is appended to the page's URL, e.g. -p norender=1.
-# -w: a warm browser, as a user who has one open: Chromium starts before the run on a local page that
-# opens the viewer as soon as the server answers, and its CPU counts from the run's start (without -w
-# the browser starts with the run, and its start-up, about 2.7 CPU seconds, falls inside the run).
+# -w: the viewer page already open, as a user keeps it: Chromium loads it from a short run (150 frames at
+# the sensor rate) on the same port, and the page reconnects by itself to the measured run; its CPU
+# counts from the measured run's start. Without -w the browser starts with the run, and its start-up
+# (about 2.7 CPU seconds) and the page's loading fall inside the run.
 # Example: scripts/measure_viewer.sh -n 3 -- --dataset ../shared/data/bonn_crowd --settings config/Bonn.yaml
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,25 +29,25 @@ for ((k = 1; k <= runs; ++k)); do
     --no-first-run --remote-debugging-port=0 --user-data-dir="$out/profile_$k")
   url="http://127.0.0.1:$port/$query"
   if ((warm)); then
-    # A local page that polls the port and opens the viewer once the run's server answers.
-    cat >"$out/wait.html" <<HTML
-<!doctype html><script>
-setInterval(() => fetch('http://127.0.0.1:$port/', {mode: 'no-cors'}).then(() => { location.href = '$url'; }, () => {}), 100);
-</script>
-HTML
-    timeout 600 chromium "${chromium_args[@]}" "file://$PWD/$out/wait.html" >/dev/null 2>&1 &
+    # The page open before the run, as a user keeps it: it is loaded from a short run on the same port
+    # and reconnects by itself to the measured run's server (the page follows the next run).
+    "$bin" -q run "${run_args[@]}" --out "$out/prime_$k" --viewer --viewer-port "$port" --frames 150 --pace sensor \
+      >/dev/null 2>"$out/prime_$k.log" &
+    prime=$!
+    sleep 0.5
+    timeout 600 chromium "${chromium_args[@]}" "$url" >/dev/null 2>&1 &
     browser=$!
-    sleep 5  # start-up done, the browser idles on the waiting page
+    wait "$prime"
   fi
   "$bin" -q run "${run_args[@]}" --out "$out/viewer_$k" --viewer --viewer-port "$port" >/dev/null 2>"$out/viewer_$k.log" &
   pid=$!
   if ((warm)); then
-    /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" --since-start &
+    /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" --since-start --interval 3600 &
   else
     sleep 0.5
     timeout 600 chromium "${chromium_args[@]}" "$url" >/dev/null 2>&1 &
     browser=$!
-    /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" &
+    /usr/bin/python3 scripts/lib/process_cpu.py "$browser" "$out/browser_cpu_$k.json" --interval 1 &
   fi
   sampler=$!
   wait "$pid"

@@ -1,11 +1,14 @@
 #!/usr/bin/python3
 """CPU time of a process tree, by process type and thread name (scripts/measure_viewer.sh).
 
-    process_cpu.py ROOT_PID OUT_JSON [--since-start]
+    process_cpu.py ROOT_PID OUT_JSON [--since-start] [--interval S]
 
 With --since-start, the CPU time the tree had used when sampling began is left out (a browser started
-earlier counts only from then on). Samples /proc every 0.2 s until ROOT_PID exits or SIGTERM arrives, keeping the newest CPU time of every
-thread of ROOT_PID and its descendants (threads and processes that ended keep their last sample), then
+earlier counts only from then on). Samples /proc every S seconds (default 0.2) until ROOT_PID exits or
+SIGTERM arrives, and once more then, keeping the newest CPU time of every thread of ROOT_PID and its
+descendants (threads and processes that ended keep their last sample). Sampling costs CPU on the
+machine being measured: a tree that lives through the measurement (a browser started earlier) needs
+only the first and the last sample, so use a long interval for it. Then
 writes {"total_s": ..., "by_type": {...}, "by_thread": {"type/thread name": seconds}} to OUT_JSON.
 The type is Chromium's --type=... (renderer, gpu-process, utility; "browser" without one).
 """
@@ -63,7 +66,10 @@ def main():
     stop = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     seen = {}  # (pid, tid) -> (type, thread name, seconds)
-    while not stop and os.path.exists(f"/proc/{root}"):
+    interval = float(sys.argv[sys.argv.index("--interval") + 1]) if "--interval" in sys.argv else 0.2
+
+    def sample():
+        nonlocal first
         for pid in descendants(root):
             kind = process_type(pid)  # read again: a process forked by the zygote sets its --type later
             try:
@@ -78,7 +84,14 @@ def main():
                         base[(pid, tid)] = seconds
                     seen[(pid, tid)] = (kind, comm, seconds - base.get((pid, tid), 0.0))
         first = False
-        time.sleep(0.2)
+
+    while not stop and os.path.exists(f"/proc/{root}"):
+        sample()
+        deadline = time.monotonic() + interval
+        while not stop and time.monotonic() < deadline and os.path.exists(f"/proc/{root}"):
+            time.sleep(min(0.1, interval))
+    if os.path.exists(f"/proc/{root}"):
+        sample()  # the last figures, taken when told to stop
     by_type, by_thread = {}, {}
     for kind, comm, seconds in seen.values():
         by_type[kind] = by_type.get(kind, 0) + seconds

@@ -14,6 +14,11 @@
 #include <regex>
 #include <thread>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include "test_support.h"
 
 using namespace crowdslam::test;
@@ -110,6 +115,63 @@ TEST(ViewerChromium, LiveRunIsDrawnAndThePauseButtonPausesIt) {
   const auto result = run.wait(120);
   EXPECT_EQ(result.exit_code, 0) << result.err;
   if (const char* keep = std::getenv("CROWDSLAM_VIEWER_SCREENSHOT")) std::filesystem::copy_file(shot, keep, std::filesystem::copy_options::overwrite_existing);
+}
+
+// A page left open across runs: when the run it shows ends and the next starts on the same port, the page
+// reconnects by itself (no reload), takes the new server's session and follows the new run from its start.
+TEST(ViewerChromium, APageLeftOpenFollowsTheNextRunOnThePort) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (scripts/setup.sh installs it)";
+  TempDir dir;
+  const auto seq = dir / "seq";
+  ASSERT_EQ(run_cli({"-q", "synth", "--out", seq.string(), "--frames", "900", "--width", "320", "--height", "240",
+                     "--trajectory", "line"}).exit_code,
+            0);
+  int port = 0;
+  {  // a free port, released again before the runs bind it
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length), 0);
+    port = ntohs(address.sin_port);
+    ::close(fd);
+  }
+  const auto start_run = [&](const std::string& name) {
+    return std::make_unique<CliProcess>(std::vector<std::string>{"-q", "run", "--dataset", seq.string(), "--out",
+                                                                 (dir / name).string(), "--viewer", "--viewer-port",
+                                                                 std::to_string(port), "--pace", "sensor"});
+  };
+  // Waits until the page has reported to this run's server from this run's session, with frames of it.
+  const auto page_follows = [&](CliProcess& run, int min_updates, nlohmann::json& s) {
+    return run.wait_until(
+        [&] {
+          s = state(port);
+          return s.is_object() && s["client"].is_object() && s["client"]["session"] == s["session"] &&
+                 s["client"]["updates"].get<int>() >= min_updates && s["client"]["frame"].get<int>() >= 0;
+        },
+        90);
+  };
+  auto first = start_run("first");
+  ASSERT_TRUE(first->wait_until([&] { return state(port).is_object(); }, 60)) << first->current_stderr();
+  start_chromium("http://127.0.0.1:" + std::to_string(port) + "/", dir / "profile", "", 150);
+  nlohmann::json s;
+  ASSERT_TRUE(page_follows(*first, 5, s)) << s.dump() << first->current_stderr();
+  const std::string first_session = s["session"];
+  first->send_signal(SIGINT);
+  EXPECT_EQ(first->wait(60).exit_code, 130);
+
+  auto second = start_run("second");
+  ASSERT_TRUE(page_follows(*second, 5, s)) << s.dump() << second->current_stderr();
+  EXPECT_NE(s["session"], first_session);
+  // The page started afresh: the frames it shows are the new run's (which is still early on), and it
+  // logged no JavaScript error through the switch.
+  const int page_frame = s["client"]["frame"].get<int>();
+  EXPECT_LE(page_frame, s["run"]["frames"].get<int>()) << s.dump();
+  EXPECT_EQ(s["client"]["errors"].get<int>(), 0) << s.dump();
+  second->send_signal(SIGINT);
+  EXPECT_EQ(second->wait(60).exit_code, 130);
 }
 
 TEST(ViewerChromium, APortInUseFailsTheRunBeforeItStarts) {

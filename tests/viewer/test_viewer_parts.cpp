@@ -127,6 +127,51 @@ TEST(EventStream, CloseWakesAWaitingClientAtOnce) {
   EXPECT_EQ(stream.published(), 0u);
 }
 
+TEST(EventStream, ABatchingClientGetsOneBatchWithOnlyTheNewestMapAndEveryFrame) {
+  viewer::EventStream stream;
+  viewer::EventStream::Cursor cursor;
+  cursor.gather = 300ms;
+  cursor.newest_only = {"map"};
+  stream.wait(cursor, 1ms);  // started: nothing retained yet
+  std::vector<viewer::EventStream::Message> batch;
+  std::thread client([&] { batch = stream.wait(cursor, 10s); });
+  // Published while the client gathers: map 1, frame 1, map 2, frame 2, map 3.
+  for (int k = 1; k <= 3; ++k) {
+    stream.publish("map", "{\"m\":" + std::to_string(k) + "}");
+    if (k < 3) stream.publish("frame", "{\"f\":" + std::to_string(k) + "}");
+    std::this_thread::sleep_for(20ms);
+  }
+  client.join();
+  std::vector<std::string> got;
+  for (const auto& m : batch) got.push_back(*m);
+  const std::vector<std::string> expected = {"event: frame\ndata: {\"f\":1}\n\n", "event: frame\ndata: {\"f\":2}\n\n",
+                                             "event: map\ndata: {\"m\":3}\n\n"};
+  EXPECT_EQ(got, expected);
+  // A client that does not batch gets every message as it comes.
+  viewer::EventStream::Cursor plain;
+  stream.wait(plain, 1ms);
+  stream.publish("map", "{\"m\":4}");
+  stream.publish("map", "{\"m\":5}");
+  EXPECT_EQ(stream.wait(plain, 1s).size(), 2u);
+}
+
+TEST(EventStream, ABatchingClientIsWokenAtOnceWhenTheStreamCloses) {
+  viewer::EventStream stream;
+  viewer::EventStream::Cursor cursor;
+  cursor.gather = 5s;
+  stream.wait(cursor, 1ms);
+  stream.publish("frame", "{}");
+  const auto start = std::chrono::steady_clock::now();
+  std::thread closer([&] {
+    std::this_thread::sleep_for(50ms);
+    stream.close();
+  });
+  const auto batch = stream.wait(cursor, 10s);
+  closer.join();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 2s);
+  EXPECT_EQ(batch.size(), 1u);  // what was published before closing still goes out
+}
+
 TEST(RunControl, PauseBlocksTheRunUntilStepLetsExactlyOneFrameThrough) {
   viewer::RunControl control;
   control.wait_while_paused(nullptr);  // running: returns at once
@@ -188,7 +233,11 @@ TEST(ViewerServer, ServesItsAssetsOnlyAndNoFileSystemPath) {
   }
   const auto state = client.Get("/state");
   ASSERT_TRUE(state);
-  EXPECT_EQ(state->body, "{\"run\":{\"frames\":3},\"client\":null}");
+  EXPECT_EQ(state->body, "{\"session\":\"" + server.session() + "\",\"run\":{\"frames\":3},\"client\":null}");
+  // Another server (the next run on this port) has another session.
+  viewer::EventStream other_stream;
+  viewer::ViewerServer other(any_port(), other_stream, nullptr, [] { return std::string("{}"); });
+  EXPECT_NE(other.session(), server.session());
   const auto pause = client.Post("/control/pause", "", "text/plain");
   ASSERT_TRUE(pause);
   EXPECT_EQ(pause->status, 409);  // a finished result cannot be paused

@@ -34,8 +34,19 @@ std::vector<EventStream::Message> EventStream::wait(Cursor& cursor, std::chrono:
     if (!out.empty() || closed_) return out;
   }
   cv_.wait_for(lock, timeout, [&] { return closed_ || sequence_ > cursor.seen; });
+  if (cursor.gather.count() > 0 && sequence_ > cursor.seen && !closed_) {
+    cv_.wait_for(lock, cursor.gather, [&] { return closed_; });
+  }
+  // Of a superseding event, only its newest message in this batch (the newest is never evicted first).
+  std::map<std::string, uint64_t> newest;
   for (const auto& entry : recent_) {
-    if (entry.sequence > cursor.seen && wanted(entry)) out.push_back(entry.message);
+    if (entry.sequence > cursor.seen && cursor.newest_only.count(entry.event)) newest[entry.event] = entry.sequence;
+  }
+  for (const auto& entry : recent_) {
+    if (entry.sequence <= cursor.seen || !wanted(entry)) continue;
+    const auto it = newest.find(entry.event);
+    if (it != newest.end() && it->second != entry.sequence) continue;
+    out.push_back(entry.message);
   }
   cursor.seen = std::max(cursor.seen, sequence_);
   return out;

@@ -4,6 +4,10 @@
 // kept, and the newest message of each event name is retained for clients that connect late (they get
 // the current map, image and status first). A client may refuse event names (a page that hides its image
 // takes no "image"); producers ask whether any connected client takes an event before making it.
+// A client may also take its messages in batches (a page that redraws twice a second): the stream then
+// gathers for a while after the first new message and sends, of the events the client names as
+// superseding (map, image), only the newest; every other message is kept. Fewer, larger writes: the
+// browser, often on the same cores as the run, wakes once per batch instead of once per message.
 // Thread-safe.
 #include <chrono>
 #include <condition_variable>
@@ -31,9 +35,12 @@ class EventStream {
     uint64_t seen = 0;     // sequence number of the last message it got
     bool started = false;  // a new client first gets the retained newest message of every event name
     std::set<std::string> skip;  // event names it does not take
+    std::chrono::milliseconds gather{0};  // batching: how long to gather after the first new message
+    std::set<std::string> newest_only;    // in a batch, only the newest message of these event names
   };
   // Messages published after `cursor` (which is advanced), waiting up to `timeout` for one; empty on
-  // timeout or once closed.
+  // timeout or once closed. With `cursor.gather`, waits that long after the first (less once closed)
+  // and thins the batch as the cursor says.
   std::vector<Message> wait(Cursor& cursor, std::chrono::milliseconds timeout);
   // Counts a connected client (the events it skips, the image width it shows, 0: any) until the returned
   // handle is released.

@@ -55,7 +55,9 @@ const std::string& viewer_page_html() {
  if (!softwareGl) { renderer.dispose(); renderer.forceContextLoss(); renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true }); }
  // The event handlers only keep the newest state; apply() shows it at most 4 times a second (2 with
  // software WebGL): every page update costs layout, painting and compositing.
- const APPLY_INTERVAL_MS = softwareGl ? 500 : 250;
+ // ?update_ms=N chooses another interval (100-5000 ms), e.g. 1000 for a browser on a busy SLAM machine.
+ const APPLY_INTERVAL_MS = params.get('update_ms') ? Math.min(5000, Math.max(100, Number(params.get('update_ms')) || 500))
+  : (softwareGl ? 500 : 250);
  let updates = 0, renders = 0;
  body.dataset.updates = '0'; body.dataset.frame = '-1'; body.dataset.points = '0'; body.dataset.webgl = 'yes';
  body.dataset.softwareGl = String(softwareGl);
@@ -224,12 +226,22 @@ const std::string& viewer_page_html() {
  function count() { updates += 1; body.dataset.updates = String(updates); maybeClick(); scheduleApply(); }
  // The server sends images only to pages that show them (it encodes none when no page does), no wider
  // than shown (in steps of 160 device pixels).
- let source = null, imageWidth = 0;
+ let source = null, imageWidth = 0, session = null;
+ function startAfresh() {
+  trajectory.length = 0; knownIds = new Set(); mapInfo = { points: 0, keyframes: 0, loops: 0 }; keyframePoses = new Map();
+  for (const key of Object.keys(pending)) pending[key] = null;
+  lastFrame = null; note = ''; delete body.dataset.finished; body.dataset.frame = '-1'; body.dataset.points = '0';
+  for (const g of [pointGeometry, keyframeLines.geometry, edgeLines.geometry, loopLines.geometry, trajectoryLine.geometry,
+                   groundTruthLine.geometry, cameraLines.geometry]) setPositions(g, []);
+  pointGeometry.deleteAttribute('color');
+  scheduleApply();
+ }
  function shownImageWidth() { return 160 * Math.max(1, Math.ceil(imageBox.clientWidth * (window.devicePixelRatio || 1) / 160)); }
  function connect() {
   if (source) source.close();
   imageWidth = shownImageWidth();
-  source = new EventSource(imageShown() ? '/events?image_width=' + imageWidth : '/events?image=0');
+  // In batches at the page's own update rate: the browser wakes twice or four times a second, not 15.
+  source = new EventSource((imageShown() ? '/events?image_width=' + imageWidth : '/events?image=0') + '&batch_ms=' + APPLY_INTERVAL_MS);
   source.addEventListener('frame', e => {
    const f = JSON.parse(e.data);  // small; every pose goes into the trajectory
    if (f.pose) trajectory.push(f.pose[0], f.pose[1], f.pose[2]);
@@ -243,7 +255,15 @@ const std::string& viewer_page_html() {
   });
   source.addEventListener('reset', e => { trajectory.length = 0; knownIds = new Set(); note = 'map reset'; count(); });
   source.addEventListener('finish', e => { body.dataset.finished = 'yes'; note = 'run ' + JSON.parse(e.data).end_state; count(); });
-  source.onerror = function () { note = 'disconnected'; scheduleApply(); };
+  source.onerror = function () { if (!body.dataset.finished) note = 'disconnected'; scheduleApply(); };  // EventSource reconnects by itself
+  source.onopen = function () { if (note === 'disconnected') { note = ''; scheduleApply(); } };
+  // Each server says its session first: a page left open across runs reconnects to the next run's server
+  // and starts afresh (no reload: three.js and the WebGL context are kept).
+  source.addEventListener('session', e => {
+   const id = JSON.parse(e.data).id;
+   if (session !== null && id !== session) startAfresh();
+   session = id; body.dataset.session = id;
+  });
  }
  connect();
 
@@ -267,7 +287,7 @@ const std::string& viewer_page_html() {
  // Status back to the server once a second (GET /state shows it: tests and scripts read it there).
  setInterval(function () {
   fetch('/client', { method: 'POST', body: JSON.stringify({ updates: updates, errors: Number(body.dataset.errors),
-   webgl: body.dataset.webgl, software_gl: softwareGl, renders: renders, images: imagesDrawn, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
+   session: session, webgl: body.dataset.webgl, software_gl: softwareGl, renders: renders, images: imagesDrawn, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
    paused: body.dataset.paused === 'true' }) }).catch(() => {});
  }, 1000);
  render();

@@ -3,12 +3,15 @@
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <thread>
+
+#include <unistd.h>
 
 #include "crowdslam/util/error.h"
 
@@ -41,6 +44,10 @@ ViewerServer::ViewerServer(ViewerServerOptions options, EventStream& stream, Run
                            std::function<std::string()> state_json)
     : options_(std::move(options)), stream_(stream), control_(control), state_json_(std::move(state_json)) {
   options_.check();
+  static std::atomic<unsigned> servers{0};
+  session_ = std::to_string(::getpid()) + "-" +
+             std::to_string(std::chrono::system_clock::now().time_since_epoch() / std::chrono::milliseconds(1)) + "-" +
+             std::to_string(servers++);
 }
 
 ViewerServer::~ViewerServer() { stop(); }
@@ -84,7 +91,7 @@ void ViewerServer::start() {
   });
   s.Get("/state", [this](const httplib::Request&, httplib::Response& res) {
     const std::string client = client_report();
-    res.set_content("{\"run\":" + (state_json_ ? state_json_() : std::string("{}")) +
+    res.set_content("{\"session\":\"" + session_ + "\",\"run\":" + (state_json_ ? state_json_() : std::string("{}")) +
                         ",\"client\":" + (client.empty() ? std::string("null") : client) + "}",
                     "application/json");
   });
@@ -107,9 +114,22 @@ void ViewerServer::start() {
     const std::string width = req.get_param_value("image_width");
     if (!width.empty() && width.size() < 6 && width.find_first_not_of("0123456789") == std::string::npos)
       image_width = std::stoi(width);
+    // batch_ms: a page that redraws every N ms takes one batch per N ms, with only the newest map and image.
+    const std::string batch = req.get_param_value("batch_ms");
+    if (!batch.empty() && batch.size() < 6 && batch.find_first_not_of("0123456789") == std::string::npos) {
+      cursor->gather = std::chrono::milliseconds(std::min(std::stoi(batch), 2000));
+      cursor->newest_only = {"map", "image", "ground_truth", "trajectory"};
+    }
     // Counted as connected while the response (and so this provider) lives.
     auto registration = stream_.register_client(cursor->skip, image_width);
-    res.set_chunked_content_provider("text/event-stream", [this, cursor, registration](size_t, httplib::DataSink& sink) {
+    // First the reconnection delay (a page left open reconnects within a second when the next run starts)
+    // and this server's session.
+    auto hello = std::make_shared<std::string>("retry: 1000\n\nevent: session\ndata: {\"id\":\"" + session_ + "\"}\n\n");
+    res.set_chunked_content_provider("text/event-stream", [this, cursor, registration, hello](size_t, httplib::DataSink& sink) {
+      if (!hello->empty()) {
+        if (!sink.write(hello->data(), hello->size())) return false;
+        hello->clear();
+      }
       const auto messages = stream_.wait(*cursor, std::chrono::milliseconds(500));
       for (const auto& m : messages) {
         if (!sink.write(m->data(), m->size())) return false;  // the client went away

@@ -43,6 +43,9 @@ class ViewerServer {
   [[nodiscard]] std::string url() const;
   // The last status a page posted (POST /client: updates received, JavaScript errors, WebGL), "" if none.
   [[nodiscard]] std::string client_report() const;
+  // Unique to this server (process and start time): every event stream begins with it, so that a page
+  // left open across runs sees a new run when it reconnects and starts afresh. GET /state shows it.
+  [[nodiscard]] const std::string& session() const { return session_; }
 
  private:
   ViewerServerOptions options_;
@@ -53,6 +56,7 @@ class ViewerServer {
   std::thread thread_;
   int port_ = 0;
   std::string three_js_, orbit_controls_js_;
+  std::string session_;
   mutable std::mutex client_mutex_;
   std::string client_report_;
 };
