@@ -15,7 +15,7 @@ const std::string& viewer_page_html() {
  #scene { position: absolute; left: 0; top: 32px; right: 0; bottom: 28px; }
  #bar { position: absolute; left: 0; right: 0; top: 0; height: 32px; background: #222; display: flex; gap: 6px; align-items: center; padding: 0 8px; }
  #status { position: absolute; left: 0; right: 0; bottom: 0; height: 28px; line-height: 28px; background: #222; padding: 0 8px; white-space: nowrap; overflow: hidden; contain: strict; }
- #imagebox { position: absolute; right: 8px; top: 40px; width: 36%; max-width: 640px; background: #000; border: 1px solid #444; line-height: 0; contain: layout paint; }
+ #imagebox { position: absolute; right: 8px; top: 40px; width: 36%; max-width: 640px; border: 1px solid #444; line-height: 0; }
  #image { width: 100%; height: auto; display: block; }
  button, label { color: #ddd; background: #333; border: 1px solid #555; padding: 3px 8px; border-radius: 3px; }
  #legend { margin-left: auto; color: #999; }
@@ -192,7 +192,7 @@ const std::string& viewer_page_html() {
   img.onload = function () {
    decoding = false;
    if (canvas.width !== m.width || canvas.height !== m.height) { canvas.width = m.width; canvas.height = m.height; }
-   ctx.drawImage(img, 0, 0); imagesDrawn += 1;
+   ctx.drawImage(img, 0, 0); imagesDrawn += 1; body.dataset.imagePanel = [imageBox.clientWidth, imageBox.clientHeight, canvas.width, canvas.height, canvas.clientHeight].join(",");
    ctx.lineWidth = 2; ctx.strokeStyle = '#3388ff';
    for (const b of m.boxes) ctx.strokeRect(b[0], b[1], b[2], b[3]);
    const dots = (flat, colour) => { ctx.fillStyle = colour; for (let i = 0; i + 1 < flat.length; i += 2) ctx.fillRect(flat[i] - 1.5, flat[i + 1] - 1.5, 3, 3); };
@@ -287,7 +287,8 @@ const std::string& viewer_page_html() {
  // Status back to the server once a second (GET /state shows it: tests and scripts read it there).
  setInterval(function () {
   fetch('/client', { method: 'POST', body: JSON.stringify({ updates: updates, errors: Number(body.dataset.errors),
-   session: session, webgl: body.dataset.webgl, software_gl: softwareGl, renders: renders, images: imagesDrawn, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
+   session: session, image_panel: [imageBox.clientWidth, imageBox.clientHeight, canvas.width, canvas.height],
+   webgl: body.dataset.webgl, software_gl: softwareGl, renders: renders, images: imagesDrawn, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
    paused: body.dataset.paused === 'true' }) }).catch(() => {});
  }, 1000);
  render();
