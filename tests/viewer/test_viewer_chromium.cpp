@@ -161,6 +161,8 @@ TEST(ViewerChromium, APageLeftOpenFollowsTheNextRunOnThePort) {
   const std::string first_session = s["session"];
   first->send_signal(SIGINT);
   EXPECT_EQ(first->wait(60).exit_code, 130);
+  // A while with nothing on the port (the user starting the next run): the page keeps trying.
+  std::this_thread::sleep_for(4s);
 
   auto second = start_run("second");
   ASSERT_TRUE(page_follows(*second, 5, s)) << s.dump() << second->current_stderr();
