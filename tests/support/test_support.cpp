@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -116,6 +117,20 @@ bool CliProcess::exited() {
 }
 
 std::string CliProcess::current_stderr() const { return read_text(tmp_ / "stderr"); }
+
+int wait_for_viewer_port(CliProcess& process, double timeout_s) {
+  int port = 0;
+  process.wait_until(
+      [&] {
+        std::smatch m;
+        const std::string err = process.current_stderr();
+        if (!std::regex_search(err, m, std::regex("viewer: http://127\\.0\\.0\\.1:([0-9]+)/"))) return false;
+        port = std::stoi(m[1]);
+        return true;
+      },
+      timeout_s);
+  return port;
+}
 
 CliResult CliProcess::wait(double timeout_s) {
   CliResult result;

@@ -89,6 +89,10 @@ class CliProcess {
   int status_ = 0;
 };
 
+// The port of the live viewer a `crowdslam run --viewer` or `crowdslam view` child prints
+// ("viewer: http://127.0.0.1:PORT/"), waiting up to `timeout_s`; 0 when it did not print one.
+int wait_for_viewer_port(CliProcess& process, double timeout_s = 60);
+
 // The message of the InputError that f() throws, or "" when it throws none.
 template <typename F>
 std::string error_of(F&& f) {

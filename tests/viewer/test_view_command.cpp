@@ -18,21 +18,6 @@ using namespace crowdslam;
 using namespace crowdslam::test;
 
 namespace {
-// Starts `crowdslam view TARGET` on any free port and returns the port (0 on failure).
-int start_view(CliProcess& view) {
-  int port = 0;
-  view.wait_until(
-      [&] {
-        std::smatch m;
-        const std::string err = view.current_stderr();
-        if (!std::regex_search(err, m, std::regex("viewer: http://127\\.0\\.0\\.1:([0-9]+)/"))) return false;
-        port = std::stoi(m[1]);
-        return true;
-      },
-      60);
-  return port;
-}
-
 // The retained events a new client gets first, by name (data parsed).
 std::map<std::string, nlohmann::json> first_events(int port) {
   std::map<std::string, nlohmann::json> events;
@@ -78,7 +63,7 @@ TEST(ViewCommand, ServesAFinishedRunAndItsSavedMapUntilInterrupted) {
 
   for (const auto& target : {out, map}) {
     CliProcess view({"view", target.string(), "--viewer-port", "0"});
-    const int port = start_view(view);
+    const int port = wait_for_viewer_port(view);
     ASSERT_GT(port, 0) << view.current_stderr();
     const auto events = first_events(port);
     ASSERT_TRUE(events.count("map")) << target;

@@ -11,7 +11,6 @@
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
-#include <regex>
 #include <thread>
 
 #include <arpa/inet.h>
@@ -58,17 +57,8 @@ TEST(ViewerChromium, LiveRunIsDrawnAndThePauseButtonPausesIt) {
             0);  // 30 s at the sensor rate: time for a browser to start on a loaded machine
   CliProcess run({"run", "--dataset", seq.string(), "--out", (dir / "out").string(), "--viewer", "--viewer-port", "0",
                   "--pace", "sensor"});
-  int port = 0;
-  ASSERT_TRUE(run.wait_until(
-      [&] {
-        std::smatch m;
-        const std::string err = run.current_stderr();
-        if (!std::regex_search(err, m, std::regex("viewer: http://127\\.0\\.0\\.1:([0-9]+)/"))) return false;
-        port = std::stoi(m[1]);
-        return true;
-      },
-      60))
-      << run.current_stderr();
+  const int port = wait_for_viewer_port(run);
+  ASSERT_GT(port, 0) << run.current_stderr();
   const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/";
   start_chromium(url + "?click=pause&after=12&points=101", dir / "profile1", "", 100);
 

@@ -192,7 +192,7 @@ const std::string& viewer_page_html() {
   img.onload = function () {
    decoding = false;
    if (canvas.width !== m.width || canvas.height !== m.height) { canvas.width = m.width; canvas.height = m.height; }
-   ctx.drawImage(img, 0, 0); imagesDrawn += 1; body.dataset.imagePanel = [imageBox.clientWidth, imageBox.clientHeight, canvas.width, canvas.height, canvas.clientHeight].join(",");
+   ctx.drawImage(img, 0, 0); imagesDrawn += 1;
    ctx.lineWidth = 2; ctx.strokeStyle = '#3388ff';
    for (const b of m.boxes) ctx.strokeRect(b[0], b[1], b[2], b[3]);
    const dots = (flat, colour) => { ctx.fillStyle = colour; for (let i = 0; i + 1 < flat.length; i += 2) ctx.fillRect(flat[i] - 1.5, flat[i + 1] - 1.5, 3, 3); };
@@ -287,7 +287,7 @@ const std::string& viewer_page_html() {
  // Status back to the server once a second (GET /state shows it: tests and scripts read it there).
  setInterval(function () {
   fetch('/client', { method: 'POST', body: JSON.stringify({ updates: updates, errors: Number(body.dataset.errors),
-   session: session, image_panel: [imageBox.clientWidth, imageBox.clientHeight, canvas.width, canvas.height],
+   session: session,
    webgl: body.dataset.webgl, software_gl: softwareGl, renders: renders, images: imagesDrawn, frame: Number(body.dataset.frame), points: Number(body.dataset.points),
    paused: body.dataset.paused === 'true' }) }).catch(() => {});
  }, 1000);

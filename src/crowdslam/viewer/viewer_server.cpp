@@ -33,6 +33,12 @@ std::string read_asset(const std::string& path) {
   out << in.rdbuf();
   return out.str();
 }
+// A query parameter of up to 5 digits; 0 when absent or anything else.
+int small_number(const httplib::Request& req, const char* name) {
+  const std::string value = req.get_param_value(name);
+  if (value.empty() || value.size() > 5 || value.find_first_not_of("0123456789") != std::string::npos) return 0;
+  return std::stoi(value);
+}
 }  // namespace
 
 void ViewerServerOptions::check() const {
@@ -110,14 +116,10 @@ void ViewerServer::start() {
     res.set_header("Cache-Control", "no-cache");
     auto cursor = std::make_shared<EventStream::Cursor>();
     if (req.get_param_value("image") == "0") cursor->skip.insert("image");  // a page that hides its image
-    int image_width = 0;  // the width the page shows the image at (0: any)
-    const std::string width = req.get_param_value("image_width");
-    if (!width.empty() && width.size() < 6 && width.find_first_not_of("0123456789") == std::string::npos)
-      image_width = std::stoi(width);
+    const int image_width = small_number(req, "image_width");  // the width the page shows the image at (0: any)
     // batch_ms: a page that redraws every N ms takes one batch per N ms, with only the newest map and image.
-    const std::string batch = req.get_param_value("batch_ms");
-    if (!batch.empty() && batch.size() < 6 && batch.find_first_not_of("0123456789") == std::string::npos) {
-      cursor->gather = std::chrono::milliseconds(std::min(std::stoi(batch), 2000));
+    if (const int batch = small_number(req, "batch_ms"); batch > 0) {
+      cursor->gather = std::chrono::milliseconds(std::min(batch, 2000));
       cursor->newest_only = {"map", "image", "ground_truth", "trajectory"};
     }
     // Counted as connected while the response (and so this provider) lives.
