@@ -278,6 +278,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "PeopleFilter.right_image: must be \"matched\" or \"boxes\""},
         BadValue{"PeopleFilter.margin_px", "PeopleFilter.margin_px: -2",
                  "PeopleFilter.margin_px: must be >= 0"},
+        BadValue{"PeopleFilter.static_check_below", "PeopleFilter.static_check_below: -1",
+                 "PeopleFilter.static_check_below: must be >= 0"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: [ 0.0, 0.6, 0.3, 0.9, 0.95 ]",
                  "FeatureBudget.thresholds: must be strictly increasing"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: 0.5",

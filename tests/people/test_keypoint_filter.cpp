@@ -21,6 +21,15 @@ TEST(KeypointFilter, PaperModeDropsInsideGrownBoxesOnly) {
   // Box 1 grown: x in [35, 105): 50 and 104 inside, 106 outside.
   EXPECT_EQ(r.keep, (std::vector<bool>{false, false, true, true, false}));
   EXPECT_EQ(r.removed, 3);
+  // Which box removed each keypoint (tracking's static-box check counts them per box).
+  EXPECT_EQ(r.box, (std::vector<int>{0, 0, -1, -1, 1}));
+}
+
+TEST(KeypointFilter, BoxIndicesCountTheCallersBoxesEvenWhenSomeAreIgnored) {
+  const std::vector<cv::KeyPoint> kps{kp(50, 50), kp(150, 150)};
+  KeypointFilterOptions options;
+  const auto r = filter_keypoints(kps, {box(40, 40, 0, 20), box(40, 40, 20, 20), box(140, 140, 20, 20)}, options);
+  EXPECT_EQ(r.box, (std::vector<int>{1, 2}));
 }
 
 TEST(KeypointFilter, DegenerateAndNanBoxesAreIgnored) {

@@ -91,9 +91,12 @@ struct PeopleFilterSettings {
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the
   // stereo match of a kept left keypoint whose right coordinate falls in a (left-image) person box.
   std::string right_image = "matched";
-  // When the filtered frame fails to track right after a tracked one, try once more with the keypoints
-  // in the boxes (tracking/tracker.h): a false-positive box over most of the image then costs no tracking.
-  bool rescue_with_boxes = false;  // off by default: on a synthetic crowd it once tracked people (docs/DETECTION.md)
+  // Keypoints in boxes that match trusted static map points and agree with the pose help tracking when
+  // the filtered frame tracks fewer than static_check_below points or fails (tracking/tracker.h,
+  // box_keypoints.cpp): a false-positive box over most of the image, or background a person box hides,
+  // then costs no tracking. Nothing in the map is made of them.
+  bool static_in_boxes = true;
+  int static_check_below = 150;
 };
 
 // Geometric dynamic check of tracked keypoints against the static map (tracking/dynamic_check.h).

@@ -14,7 +14,8 @@ Frame::Frame(uint64_t id_in, double timestamp_s_in, std::shared_ptr<const geomet
       map_points(features->size()),
       outliers(features->size(), false),
       dynamic(features->size(), false),
-      motion_history(features->size(), 0) {}
+      motion_history(features->size(), 0),
+      in_box(features->size(), false) {}
 
 std::optional<PointProjection> Frame::project(const MapPoint& point, double min_view_cos) const {
   const geometry::Vec3 world = point.world();

@@ -44,6 +44,9 @@ class Frame {
   // its last three checked observations (bits 0-2, newest in bit 0) and how many there were (bits 4-5).
   std::vector<bool> dynamic;
   std::vector<uint8_t> motion_history;
+  // Keypoints inside person boxes that tracking took back because they match trusted static map points
+  // (Tracker::track): they help the pose, but nothing new in the map is made of them.
+  std::vector<bool> in_box;
   std::optional<geometry::SE3> cam_from_world;
   std::shared_ptr<KeyFrame> reference_keyframe;
 

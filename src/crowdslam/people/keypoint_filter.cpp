@@ -53,11 +53,14 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
                               const cv::Mat& depth_image_raw, double depth_factor) {
   FilterResult result;
   result.keep.assign(keypoints.size(), true);
+  result.box.assign(keypoints.size(), -1);
   if (boxes.empty()) return result;
   const float margin = static_cast<float>(options.margin_px);
   std::vector<cv::Rect2f> grown;
+  std::vector<int> origin;  // index in `boxes` of each grown box
   grown.reserve(boxes.size());
-  for (const auto& b : boxes) {
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    const PersonBox& b = boxes[k];
     // Zero, negative or non-finite boxes are ignored (NaN fails every comparison, so check explicitly).
     if (!(b.box.width > 0) || !(b.box.height > 0) || !std::isfinite(b.box.x) || !std::isfinite(b.box.y) ||
         !std::isfinite(b.box.width) || !std::isfinite(b.box.height)) {
@@ -65,6 +68,7 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
     }
     grown.emplace_back(b.box.x - margin, b.box.y - margin, b.box.width + 2 * margin,
                        b.box.height + 2 * margin);
+    origin.push_back(static_cast<int>(k));
     if (options.mode == FilterMode::kDepth) {
       result.person_depth_m.push_back(estimate_person_depth(depth_image_raw, depth_factor, b.box));
     }
@@ -81,6 +85,7 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
         if (person > 0 && depth_m[i] > person + options.depth_margin_m) continue;
       }
       result.keep[i] = false;
+      result.box[i] = origin[b];
       ++result.removed;
       break;
     }

@@ -27,6 +27,7 @@ struct KeypointFilterOptions {
 
 struct FilterResult {
   std::vector<bool> keep;  // one flag per keypoint
+  std::vector<int> box;    // per keypoint: the index (into `boxes`) of the box that removed it, -1 = kept
   int removed = 0;
   std::vector<double> person_depth_m;  // depth mode: per box (<= 0: unknown, whole box filtered)
 };

@@ -58,6 +58,8 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"detection_frame", r.detection_frame},
           {"boxes_propagated", r.boxes_propagated},
           {"rescued_with_boxes", r.rescued_with_boxes},
+          {"box_matches", r.box_matches},
+          {"static_boxes", r.static_boxes},
           {"keypoints_dynamic", r.keypoints_dynamic},
           {"dynamic_grown", r.dynamic_grown},
           {"matches_moving", r.matches_moving},
@@ -201,7 +203,8 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     doc["vocabulary"] = nullptr;
   }
   std::vector<double> detector_ms, detector_wait_ms;
-  int rescued = 0;
+  int rescued = 0, frames_with_box_matches = 0, frames_with_static_boxes = 0;
+  long box_matches = 0;
   double waited_for_mapping_ms = 0;
   int frames_waited = 0;
   long dynamic_total = 0, grown_total = 0, culled_total = 0;
@@ -214,6 +217,9 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     frames_with_dynamic += r.keypoints_dynamic > 0 ? 1 : 0;
     frames_check_skipped += r.dynamic_check_skipped ? 1 : 0;
     rescued += r.rescued_with_boxes ? 1 : 0;
+    frames_with_box_matches += r.box_matches > 0 ? 1 : 0;
+    box_matches += r.box_matches;
+    frames_with_static_boxes += r.static_boxes > 0 ? 1 : 0;
     if (r.detector_ms > 0) detector_ms.push_back(r.detector_ms);  // latest mode: frames with a new detection
     detector_wait_ms.push_back(r.detector_wait_ms);
     waited_for_mapping_ms += r.waited_for_mapping_ms;
@@ -233,7 +239,11 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                               {"mode", s.people_filter.mode},
                                               {"margin_px", s.people_filter.margin_px},
                                               {"filter_before_nms", s.detector.filter_before_nms},
-                                              {"rescue_with_boxes", s.people_filter.rescue_with_boxes},
+                                              {"static_in_boxes", s.people_filter.static_in_boxes},
+                                              {"static_check_below", s.people_filter.static_check_below},
+                                              {"frames_with_box_matches", frames_with_box_matches},
+                                              {"box_matches", box_matches},
+                                              {"frames_with_static_boxes", frames_with_static_boxes},
                                               {"frames_rescued_with_boxes", rescued},
                                               {"feature_budget", s.feature_budget.enabled},
                                               {"area", s.feature_budget.area},

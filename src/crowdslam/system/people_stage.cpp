@@ -264,8 +264,11 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     kept.descriptors.create(static_cast<int>(raw.keys.size()) - filtered.removed, raw.descriptors.cols,
                             raw.descriptors.type());
     int row = 0;
+    out.filtered_index.assign(raw.keys.size(), -1);
+    out.box_of = filtered.box;
     for (size_t i = 0; i < raw.keys.size(); ++i) {
       if (filtered.keep[i]) {
+        out.filtered_index[i] = row;
         raw.descriptors.row(static_cast<int>(i)).copyTo(kept.descriptors.row(row++));
         kept.keys.push_back(raw.keys[i]);
         if (stereo) {

@@ -51,6 +51,10 @@ struct PeopleFrame {
   bool boxes_propagated = false;  // boxes moved here from an earlier frame by the image flow
   std::vector<people::PersonBox> boxes;  // used for filtering
   std::vector<cv::KeyPoint> removed_keypoints;  // only when recording keypoints
+  // When the filter removed keypoints: per keypoint before the filter, its index after it (-1 = removed)
+  // and the box that removed it (index into `boxes`, -1 = kept).
+  std::vector<long> filtered_index;
+  std::vector<int> box_of;
 };
 
 struct PeopleStageStats {

@@ -62,6 +62,8 @@ System::System(const io::Settings& settings, const SystemOptions& options)
 
   tracking::TrackerOptions tracker_options;
   tracker_options.close_depth_m = close_depth_m;
+  tracker_options.box_keypoints = settings.people_filter.static_in_boxes;
+  tracker_options.box_check_below = settings.people_filter.static_check_below;
   tracker_options.max_wait_for_mapping_ms = options.sequential ? 0.0 : options.max_wait_for_mapping_ms;
   tracker_options.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   if (options.sensor == io::SensorKind::kMonocular) {
@@ -225,10 +227,12 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     frame_builder_->match_stereo(raw, raw_right);
     report.stereo_match_ms = elapsed_ms(match_start);
   }
-  // The keypoints before the filter: tracking may try them when the filtered frame fails (Tracker::track).
+  // The keypoints before the filter: tracking may take back those in boxes (Tracker::track).
   std::optional<tracking::RawFeatures> unfiltered;
+  std::vector<long> filtered_index;
+  std::vector<int> box_of;
   if (people_) {
-    if (settings_.people_filter.rescue_with_boxes) {
+    if (settings_.people_filter.static_in_boxes) {
       unfiltered.emplace(tracking::RawFeatures{raw.keys, raw.descriptors.clone(), raw.right_u, raw.depth_m});
     }
     PeopleFrame p = people_->filter(frame_index, images, raw, options_.record_keypoints);
@@ -243,6 +247,8 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     report.boxes = std::move(p.boxes);
     report.removed_keypoints = std::move(p.removed_keypoints);
     next_feature_budget_ = people_->next_feature_budget();
+    filtered_index = std::move(p.filtered_index);
+    box_of = std::move(p.box_of);
     if (unfiltered && unfiltered->keys.size() == raw.keys.size()) unfiltered.reset();  // nothing was removed
   }
   if (options_.record_keypoints) report.kept_keypoints = raw.keys;
@@ -260,15 +266,17 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
 
   const auto tracking_start = std::chrono::steady_clock::now();
   map::Frame frame(next_frame_id_++, timestamp_s, camera_, frame_builder_->levels(), std::move(features));
-  tracking::Tracker::UnfilteredFeatures unfiltered_features;
-  if (unfiltered) {
-    unfiltered_features = [&]() -> std::shared_ptr<const map::FrameFeatures> {
+  tracking::Tracker::BoxKeypoints box_keypoints;
+  if (unfiltered && filtered_index.size() == unfiltered->keys.size()) {
+    box_keypoints.filtered_index = std::move(filtered_index);
+    box_keypoints.box_of = std::move(box_of);
+    box_keypoints.features = [&]() -> std::shared_ptr<const map::FrameFeatures> {
       if (stereo) return frame_builder_->assemble_stereo(std::move(*unfiltered));
       const cv::Mat depth = options_.sensor == io::SensorKind::kRgbd ? images.depth : cv::Mat();
       return frame_builder_->assemble(std::move(*unfiltered), depth);
     };
   }
-  const tracking::TrackResult result = tracker_->track(std::move(frame), unfiltered_features);
+  const tracking::TrackResult result = tracker_->track(std::move(frame), box_keypoints);
   if (options_.sequential) {
     mapper_->process_all();
     if (loop_closer_) loop_closer_->process_all();
@@ -279,6 +287,8 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.method = result.method;
   report.new_keyframe = result.new_keyframe;
   report.rescued_with_boxes = result.rescued_with_boxes;
+  report.box_matches = result.box_matches;
+  report.static_boxes = result.static_boxes;
   report.waited_for_mapping_ms = result.waited_for_mapping_ms;
   report.keypoints_dynamic = result.dynamic.dynamic;
   report.dynamic_grown = result.dynamic.grown;

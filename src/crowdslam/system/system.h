@@ -72,7 +72,9 @@ struct FrameReport {
   double detector_wait_ms = 0; // how long tracking waited for the boxes after ORB extraction
   int64_t detection_frame = -1;  // frame the boxes were detected on (-1: none yet)
   bool boxes_propagated = false; // boxes moved here from an earlier frame (Detector.mode latest)
-  bool rescued_with_boxes = false;  // tracked only with the keypoints in boxes added back (Tracker::track)
+  bool rescued_with_boxes = false;  // the filtered frame failed; the keypoints in boxes tracked it (Tracker::track)
+  int box_matches = 0;              // tracked points that are keypoints in person boxes (Tracker::track)
+  int static_boxes = 0;             // boxes the static map vouched for, their keypoints released (Tracker::track)
   // Geometric dynamic check (tracking/dynamic_check.h): keypoints judged dynamic (of them, added by region
   // growing), matches whose residual moved in this frame, map points culled as moving.
   int keypoints_dynamic = 0;

@@ -5,13 +5,14 @@
 #include <cmath>
 
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::tracking {
 namespace {
 
-constexpr double kChi2Mono = 5.991;    // 2 dof, 95 %
-constexpr double kChi2Stereo = 7.815;  // 3 dof, 95 %
+constexpr double kChi2Mono = kMatchChi2Mono;
+constexpr double kChi2Stereo = kMatchChi2Stereo;
 
 int evaluations(uint8_t history) { return (history >> 4) & 0x3; }
 int moving_votes(uint8_t history) {
@@ -24,33 +25,9 @@ uint8_t push_verdict(uint8_t history, bool moving) {
   return static_cast<uint8_t>(bits | (n << 4));
 }
 
-// Keypoint i's error against its point seen from `pose`: reprojection plus, with depth, disparity, weighed
-// by the keypoint's level (chi2, 3 dof with depth, 2 without); a point behind the camera is far off.
-struct Residual {
-  double chi2 = 0;
-  double threshold = kChi2Mono;  // the 95 % chi-square threshold for its degrees of freedom
-};
+using Residual = MatchResidual;
 Residual residual(const map::Frame& frame, size_t i, const map::MapPoint& point, const geometry::SE3& pose) {
-  const auto& f = *frame.features;
-  const geometry::PinholeCamera& camera = *frame.camera;
-  const bool with_depth = f.has_right(i) && camera.is_stereo();
-  Residual r;
-  r.threshold = with_depth ? kChi2Stereo : kChi2Mono;
-  const geometry::Vec3 in_cam = pose * point.world();
-  if (in_cam.z() <= 0) {
-    r.chi2 = 1e9;
-    return r;
-  }
-  const geometry::Vec2 pixel = camera.project(in_cam);
-  const double du = f.keys_un[i].pt.x - pixel.x();
-  const double dv = f.keys_un[i].pt.y - pixel.y();
-  double e2 = du * du + dv * dv;
-  if (with_depth) {
-    const double dr = f.right_u[i] - (pixel.x() - camera.bf / in_cam.z());
-    e2 += dr * dr;
-  }
-  r.chi2 = e2 * frame.levels->inv_sigma2[f.keys_un[i].octave];
-  return r;
+  return match_residual(frame, i, point, pose);
 }
 
 // The frame's residual scale: the median of its matches' chi2, each divided by the median of its

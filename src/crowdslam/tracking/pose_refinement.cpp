@@ -42,4 +42,27 @@ int discard_outliers_count_map_points(map::Frame& frame) {
   return in_map;
 }
 
+MatchResidual match_residual(const map::Frame& frame, size_t i, const map::MapPoint& point, const geometry::SE3& pose) {
+  const auto& f = *frame.features;
+  const geometry::PinholeCamera& camera = *frame.camera;
+  const bool with_depth = f.has_right(i) && camera.is_stereo();
+  MatchResidual r;
+  r.threshold = with_depth ? kMatchChi2Stereo : kMatchChi2Mono;
+  const geometry::Vec3 in_cam = pose * point.world();
+  if (in_cam.z() <= 0) {
+    r.chi2 = 1e9;
+    return r;
+  }
+  const geometry::Vec2 pixel = camera.project(in_cam);
+  const double du = f.keys_un[i].pt.x - pixel.x();
+  const double dv = f.keys_un[i].pt.y - pixel.y();
+  double e2 = du * du + dv * dv;
+  if (with_depth) {
+    const double dr = f.right_u[i] - (pixel.x() - camera.bf / in_cam.z());
+    e2 += dr * dr;
+  }
+  r.chi2 = e2 * frame.levels->inv_sigma2[f.keys_un[i].octave];
+  return r;
+}
+
 }  // namespace crowdslam::tracking

@@ -14,4 +14,15 @@ int optimize_frame_pose(map::Frame& frame, const optim::PoseOptimizerOptions& op
 // at least one observation (visual-odometry points of the last frame do not count).
 int discard_outliers_count_map_points(map::Frame& frame);
 
+// Keypoint i's error against map point `point` seen from `pose`: reprojection plus, when the keypoint has
+// a right coordinate (stereo / depth), disparity, weighed by the keypoint's level as the pose optimisation
+// weighs it (a chi-square value with 3 dof with depth, 2 without); a point behind the camera is far off.
+constexpr double kMatchChi2Mono = 5.991;    // 2 dof, 95 %
+constexpr double kMatchChi2Stereo = 7.815;  // 3 dof, 95 %
+struct MatchResidual {
+  double chi2 = 0;
+  double threshold = kMatchChi2Mono;  // the 95 % chi-square threshold for its degrees of freedom
+};
+MatchResidual match_residual(const map::Frame& frame, size_t i, const map::MapPoint& point, const geometry::SE3& pose);
+
 }  // namespace crowdslam::tracking

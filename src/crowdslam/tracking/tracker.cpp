@@ -69,7 +69,7 @@ void Tracker::start_in_loaded_map(bool localization_only) {
   localization_only_ = localization_only;
 }
 
-TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltered) {
+TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
   TrackResult result;
   result.keypoints = static_cast<int>(frame.size());
   std::unique_lock map_lock(map_->update_mutex());
@@ -115,18 +115,14 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
       }
       dynamic_check_.set_suspended(false);
     }
-    if (!ok && was_tracking && unfiltered && velocity_) {
-      if (auto features = unfiltered()) {
-        map::Frame full(frame.id, frame.timestamp_s, frame.camera, frame.levels, std::move(features));
-        if (track_with_motion_model(full)) {
-          full.reference_keyframe = reference_keyframe_;
-          if (track_local_map(full)) {
-            frame = std::move(full);
-            ok = true;
-            result.method = "motion+boxes";
-            result.rescued_with_boxes = true;
-          }
+    if (boxes && options_.box_keypoints && (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking)) {
+      if (auto full = with_box_keypoints(frame, ok, boxes, result.static_boxes)) {
+        if (!ok) {
+          result.method = "motion+boxes";
+          result.rescued_with_boxes = true;
         }
+        frame = std::move(*full);
+        ok = true;
       }
     }
     state_ = ok ? TrackingState::kOk : TrackingState::kLost;
@@ -141,6 +137,10 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
       inliers_in_local_map_ = count_tracked_in_map(frame);
     }
     if (ok) {
+      for (size_t i = 0; i < frame.size(); ++i) {
+        const bool boxed = !boxes.box_of.empty() && boxes.box_of.size() == frame.size() && boxes.box_of[i] >= 0;
+        if (boxed && frame.map_points[i] && !frame.outliers[i] && !frame.dynamic[i]) ++result.box_matches;
+      }
       lost_frames_ = 0;
       if (last_frame_ && last_frame_->cam_from_world) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
@@ -152,8 +152,7 @@ TrackResult Tracker::track(map::Frame frame, const UnfilteredFeatures& unfiltere
         if (p && p->num_observations() < 1) p.reset();
       }
       temporal_points_.clear();
-      KeyframeDecision decision = localization_only_ || result.rescued_with_boxes ? KeyframeDecision::kNo
-                                                                                   : need_new_keyframe(frame);
+      KeyframeDecision decision = localization_only_ ? KeyframeDecision::kNo : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
         // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
         // mapper can write its bundle adjustment back) rather than track on without new points.
@@ -291,7 +290,7 @@ void Tracker::update_last_frame() {
   const auto& f = *last.features;
   std::vector<std::pair<float, size_t>> by_depth;
   for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] > 0) by_depth.emplace_back(f.depth_m[i], i);
+    if (f.depth_m[i] > 0 && !last.in_box[i]) by_depth.emplace_back(f.depth_m[i], i);
   }
   if (by_depth.empty()) return;
   std::sort(by_depth.begin(), by_depth.end());
@@ -483,7 +482,7 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
   int untracked_close = 0;
   const auto& f = *frame.features;
   for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] > 0 && f.depth_m[i] < options_.close_depth_m && !frame.dynamic[i]) {
+    if (f.depth_m[i] > 0 && f.depth_m[i] < options_.close_depth_m && !frame.dynamic[i] && !frame.in_box[i]) {
       if (frame.map_points[i] && !frame.outliers[i]) {
         ++tracked_close;
       } else {
@@ -508,12 +507,18 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
 }
 
 void Tracker::create_new_keyframe(map::Frame& frame) {
-  // Dynamic keypoints (dynamic_check.h) are left out of the keyframe, so nothing in the map (points from
-  // depth here, triangulation and fusion in local mapping) is ever made of them.
+  // Dynamic keypoints (dynamic_check.h) and keypoints in person boxes are left out of the keyframe, so
+  // nothing in the map (points from depth here, triangulation and fusion in local mapping) is made of them.
   std::vector<long> to_keyframe;
   std::shared_ptr<const map::FrameFeatures> features = frame.features;
-  if (std::find(frame.dynamic.begin(), frame.dynamic.end(), true) != frame.dynamic.end()) {
-    features = features_without(*frame.features, frame.dynamic, to_keyframe, vocabulary_.get());
+  std::vector<bool> left_out(frame.size(), false);
+  bool any_left_out = false;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    left_out[i] = frame.dynamic[i] || frame.in_box[i];
+    any_left_out = any_left_out || left_out[i];
+  }
+  if (any_left_out) {
+    features = features_without(*frame.features, left_out, to_keyframe, vocabulary_.get());
   } else {
     if (vocabulary_) ensure_bow(frame, *vocabulary_);  // keyframes carry their bag of words
     features = frame.features;

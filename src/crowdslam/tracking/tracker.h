@@ -48,6 +48,15 @@ struct TrackerOptions {
   // map does not cover; a new map tracks it from here on, and the old map's poses stay in the outputs as
   // their own segment. Never with a loaded map. Usually one second of frames.
   int new_map_after_lost_frames = 30;
+  // Keypoints in person boxes (Tracker::track, BoxKeypoints): taken back for the pose when the filtered
+  // frame tracks fewer than box_check_below points or fails, if they match map points seen at least
+  // box_min_observations times (a depth observation counts twice) and judged moving at most once in
+  // their last 8 checks, and agree with the pose of the keypoints outside the boxes (when those failed:
+  // box_rescue_min_inliers inliers of the pose from the motion model).
+  bool box_keypoints = true;
+  int box_check_below = 150;
+  int box_min_observations = 2;
+  int box_rescue_min_inliers = 50;
   optim::PoseOptimizerOptions pose;
   // Geometric dynamic check of the tracked keypoints (dynamic_check.h).
   DynamicCheckOptions dynamic;
@@ -68,7 +77,9 @@ struct TrackResult {
   int tracked_points = 0;   // inliers after local-map tracking
   int keypoints = 0;
   const char* method = "";  // "init", "motion", "reference", "relocalization", "motion+boxes", "lost"
-  // Tracked only with the keypoints inside person boxes added back (see Tracker::track).
+  int box_matches = 0;      // keypoints in person boxes among the tracked points (BoxKeypoints)
+  int static_boxes = 0;     // boxes whose keypoints the static map vouched for (released, see box_keypoints.cpp)
+  // The filtered frame failed and the keypoints in boxes tracked it (method "motion+boxes").
   bool rescued_with_boxes = false;
   double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
   DynamicCheckStats dynamic;         // the geometric dynamic check of this frame (zeros when off or lost)
@@ -78,17 +89,27 @@ class Tracker {
  public:
   Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, KeyframeConsumer* mapper);
 
-  // The frame's features before the people filter removed any (built only when asked for).
-  using UnfilteredFeatures = std::function<std::shared_ptr<const map::FrameFeatures>()>;
+  // The keypoints the people filter took out of a frame.
+  struct BoxKeypoints {
+    // The frame's features before the filter (built only when asked for).
+    std::function<std::shared_ptr<const map::FrameFeatures>()> features;
+    // Per keypoint of those features: its index in the filtered frame, -1 = in a person box, and the
+    // box it is in (any numbering, -1 = outside the boxes).
+    std::vector<long> filtered_index;
+    std::vector<int> box_of;
+    explicit operator bool() const { return static_cast<bool>(features); }
+  };
 
   // Tracks one frame; `frame` is consumed (kept as the last frame).
-  // `unfiltered` (optional): when the filtered frame fails to track right after a tracked one, tracking
-  // is tried once more with every keypoint, boxes included, from the motion model: the pose optimisation's
-  // chi-square test keeps only matches that move with the camera. A person box that is a false positive
-  // (a poster, a textured wall) covering most of the image then costs no tracking; keypoints on people
-  // who really move are rejected as outliers. Such a frame never becomes a keyframe (no map points are
-  // created from keypoints in boxes). Reported as method "motion+boxes".
-  TrackResult track(map::Frame frame, const UnfilteredFeatures& unfiltered = {});
+  // `boxes` (optional, TrackerOptions::box_keypoints): when the filtered frame tracks few points or fails,
+  // the keypoints in person boxes are matched to the trusted static map points of the local map (seen
+  // often, not judged moving) and, if they agree with the pose of the keypoints outside the boxes (or,
+  // when those failed, with the motion model through the pose optimisation's chi-square test), help the
+  // pose. A false-positive box (a poster, a textured wall) covering most of the image then costs no
+  // tracking, and static background a person box hides still counts; a person who moves does not agree.
+  // Nothing in the map is made of keypoints in boxes (Frame::in_box). A frame the box keypoints rescued is
+  // reported as method "motion+boxes".
+  TrackResult track(map::Frame frame, const BoxKeypoints& boxes = {});
 
   // Place recognition for relocalisation (optional; not owned). With it, frames that have a bag of words
   // relocalise against the database's candidates; without it, against recent keyframes (brute force).
@@ -127,6 +148,9 @@ class Tracker {
                                                        const std::shared_ptr<map::KeyFrame>& keyframe,
                                                        size_t keyframe_index) const;
   int count_tracked_in_map(const map::Frame& frame) const;
+  // The frame with its keypoints in boxes back (see track); nullopt when they do not help.
+  std::optional<map::Frame> with_box_keypoints(const map::Frame& frame, bool tracked, const BoxKeypoints& boxes,
+                                               int& static_boxes);
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
