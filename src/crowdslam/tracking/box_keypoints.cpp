@@ -131,4 +131,17 @@ std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, b
   return full;
 }
 
+std::optional<map::Frame> Tracker::relocalize_with_box_keypoints(const map::Frame& frame, const BoxKeypoints& boxes) {
+  auto features = boxes.features();
+  if (!features || features->size() != boxes.filtered_index.size()) return std::nullopt;
+  map::Frame full(frame.id, frame.timestamp_s, frame.camera, frame.levels, features);
+  for (size_t i = 0; i < full.size(); ++i) full.in_box[i] = boxes.filtered_index[i] < 0;
+  // Place recognition and the PnP check of relocalize(), then the local map with the 50 inliers asked
+  // of a frame right after relocalisation: a box keypoint counts only as a match that agrees.
+  if (!relocalize(full)) return std::nullopt;
+  full.reference_keyframe = reference_keyframe_;
+  if (!track_local_map(full)) return std::nullopt;
+  return full;
+}
+
 }  // namespace crowdslam::tracking

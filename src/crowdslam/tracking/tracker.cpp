@@ -125,6 +125,15 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
         ok = true;
       }
     }
+    if (!ok && boxes && options_.box_keypoints && !was_tracking) {
+      // Lost, and the filter left too little to relocalise: the whole image may still show the map.
+      if (auto full = relocalize_with_box_keypoints(frame, boxes)) {
+        frame = std::move(*full);
+        ok = true;
+        result.method = "relocalization+boxes";
+        result.rescued_with_boxes = true;
+      }
+    }
     state_ = ok ? TrackingState::kOk : TrackingState::kLost;
     if (!ok) result.method = "lost";
 

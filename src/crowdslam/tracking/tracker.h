@@ -52,7 +52,7 @@ struct TrackerOptions {
   // frame tracks fewer than box_check_below points or fails, if they match map points seen at least
   // box_min_observations times (a depth observation counts twice) and judged moving at most once in
   // their last 8 checks, and agree with the pose of the keypoints outside the boxes (when those failed:
-  // box_rescue_min_inliers inliers of the pose from the motion model).
+  // box_rescue_min_inliers inliers of the pose from the motion model; System uses 30 for monocular).
   bool box_keypoints = true;
   int box_check_below = 150;
   int box_min_observations = 2;
@@ -151,6 +151,8 @@ class Tracker {
   // The frame with its keypoints in boxes back (see track); nullopt when they do not help.
   std::optional<map::Frame> with_box_keypoints(const map::Frame& frame, bool tracked, const BoxKeypoints& boxes,
                                                int& static_boxes);
+  // Relocalisation of a lost frame with its keypoints in boxes back (see track); nullopt when it fails.
+  std::optional<map::Frame> relocalize_with_box_keypoints(const map::Frame& frame, const BoxKeypoints& boxes);
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
