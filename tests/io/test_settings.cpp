@@ -280,6 +280,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "PeopleFilter.margin_px: must be >= 0"},
         BadValue{"PeopleFilter.static_check_below", "PeopleFilter.static_check_below: -1",
                  "PeopleFilter.static_check_below: must be >= 0"},
+        BadValue{"PeopleFilter.static_in_boxes", "PeopleFilter.static_in_boxes: \"sometimes\"",
+                 "PeopleFilter.static_in_boxes: must be \"monocular\", \"always\" or \"never\""},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: [ 0.0, 0.6, 0.3, 0.9, 0.95 ]",
                  "FeatureBudget.thresholds: must be strictly increasing"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: 0.5",

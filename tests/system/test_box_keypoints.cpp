@@ -1,6 +1,6 @@
 // End-to-end: keypoints in person boxes taken back by the static map (tracking/box_keypoints.cpp). A box
-// that is a false positive covering nearly the whole image of a static synthetic room must cost no
-// tracking; with the check off the same box loses the camera.
+// that is a false positive covering nearly the whole image of a static synthetic room costs no tracking
+// with PeopleFilter.static_in_boxes "always"; with the RGB-D default (off) the same box loses the camera.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -30,12 +30,15 @@ std::filesystem::path make_room(const test::TempDir& tmp) {
   return dir;
 }
 
-run::RunSummary run_room(const std::filesystem::path& dataset, const std::filesystem::path& out, bool static_in_boxes) {
+// `static_in_boxes` empty: the settings' default ("monocular": not used in this RGB-D run).
+run::RunSummary run_room(const std::filesystem::path& dataset, const std::filesystem::path& out,
+                         const std::string& static_in_boxes) {
   const auto settings = out.string() + ".yaml";
   {
     std::ifstream in(dataset / "settings.yaml");
     std::ofstream copy(settings);
-    copy << in.rdbuf() << "\nPeopleFilter.static_in_boxes: " << (static_in_boxes ? 1 : 0) << "\n";
+    copy << in.rdbuf() << "\n";
+    if (!static_in_boxes.empty()) copy << "PeopleFilter.static_in_boxes: \"" << static_in_boxes << "\"\n";
   }
   run::RunOptions options;
   options.dataset = dataset.string();
@@ -53,13 +56,13 @@ TEST(RunBoxKeypoints, AFalsePositiveOverNearlyTheWholeImageCostsNoTracking) {
   test::TempDir tmp;
   const auto dataset = make_room(tmp);
 
-  const auto with_check = run_room(dataset, tmp / "on", true);
+  const auto with_check = run_room(dataset, tmp / "on", "always");
   EXPECT_EQ(with_check.tracked, static_cast<size_t>(kFrames));
   EXPECT_EQ(with_check.json["summary"]["map_resets"].get<int>(), 0);
   ASSERT_TRUE(with_check.ate_rmse_m.has_value());
   EXPECT_LT(*with_check.ate_rmse_m, 0.02);
   const auto& people = with_check.json["people_filter"];
-  EXPECT_TRUE(people["static_in_boxes"].get<bool>());
+  EXPECT_EQ(people["static_in_boxes"], "always");
   // Under the box the frame keeps almost no keypoint of its own: its tracked points are box keypoints
   // that matched the map's static points and agreed with the pose.
   int frames_with_box_matches = 0;
@@ -75,8 +78,10 @@ TEST(RunBoxKeypoints, AFalsePositiveOverNearlyTheWholeImageCostsNoTracking) {
   EXPECT_GE(frames_with_box_matches, kLastBoxFrame - kFirstBoxFrame);
   EXPECT_EQ(people["frames_with_box_matches"].get<int>(), frames_with_box_matches);
 
-  // The same box with the check off: the filtered frames have too little left and the camera is lost.
-  const auto without = run_room(dataset, tmp / "off", false);
+  // The same box with the default for RGB-D (box keypoints with depth only in monocular): the filtered
+  // frames have too little left and the camera is lost.
+  const auto without = run_room(dataset, tmp / "default", "");
+  EXPECT_EQ(without.json["people_filter"]["static_in_boxes"], "monocular");
   EXPECT_LT(without.tracked, static_cast<size_t>(kFrames) - 5);
   EXPECT_EQ(without.json["people_filter"]["frames_with_box_matches"].get<int>(), 0);
 }

@@ -88,7 +88,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
   set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
   set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
-  set_if(r.flag("PeopleFilter.static_in_boxes"), s.people_filter.static_in_boxes);
+  set_if(r.text("PeopleFilter.static_in_boxes"), s.people_filter.static_in_boxes);
   set_if(r.integer("PeopleFilter.static_check_below"), s.people_filter.static_check_below);
   set_if(r.flag("Geometry.dynamic_check"), s.geometry.dynamic_check);
   set_if(r.real("Geometry.moving_factor"), s.geometry.moving_factor);

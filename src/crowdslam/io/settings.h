@@ -95,7 +95,9 @@ struct PeopleFilterSettings {
   // the filtered frame tracks fewer than static_check_below points or fails (tracking/tracker.h,
   // box_keypoints.cpp): a false-positive box over most of the image, or background a person box hides,
   // then costs no tracking. Nothing in the map is made of them.
-  bool static_in_boxes = true;
+  // "monocular" (default): with --sensor mono only, where a box hides the background behind a person
+  // (no depth mode to keep it); "always"; "never". Measured in docs/DETECTION.md.
+  std::string static_in_boxes = "monocular";
   int static_check_below = 150;
 };
 

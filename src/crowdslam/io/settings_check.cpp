@@ -192,6 +192,9 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(p.depth_margin_m) && p.depth_margin_m >= 0, "PeopleFilter.depth_margin_m", ">= 0",
             p.depth_margin_m);
   c.require(p.static_check_below >= 0, "PeopleFilter.static_check_below", ">= 0", p.static_check_below);
+  c.require(p.static_in_boxes == "monocular" || p.static_in_boxes == "always" || p.static_in_boxes == "never",
+            "PeopleFilter.static_in_boxes", "\"monocular\", \"always\" or \"never\"",
+            "\"" + p.static_in_boxes + "\"");
   const auto& g = s.geometry;
   c.require(std::isfinite(g.moving_factor) && g.moving_factor > 0, "Geometry.moving_factor", "> 0", g.moving_factor);
   c.require(std::isfinite(g.certain_factor) && (g.certain_factor == 0 || g.certain_factor >= g.moving_factor),

@@ -104,7 +104,7 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
       << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
       << "\nPeopleFilter.right_image: " << quoted(p.right_image)
-      << "\nPeopleFilter.static_in_boxes: " << (p.static_in_boxes ? 1 : 0)
+      << "\nPeopleFilter.static_in_boxes: " << quoted(p.static_in_boxes)
       << "\nPeopleFilter.static_check_below: " << p.static_check_below << "\n\n";
   const auto& g = s.geometry;
   out << "# Geometric dynamic check of tracked keypoints\nGeometry.dynamic_check: " << (g.dynamic_check ? 1 : 0)

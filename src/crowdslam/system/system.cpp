@@ -62,8 +62,11 @@ System::System(const io::Settings& settings, const SystemOptions& options)
 
   tracking::TrackerOptions tracker_options;
   tracker_options.close_depth_m = close_depth_m;
-  tracker_options.box_keypoints = settings.people_filter.static_in_boxes;
+  const std::string& in_boxes = settings.people_filter.static_in_boxes;
+  tracker_options.box_keypoints =
+      in_boxes == "always" || (in_boxes == "monocular" && options.sensor == io::SensorKind::kMonocular);
   tracker_options.box_check_below = settings.people_filter.static_check_below;
+  tracker_options.box_rescue = true;
   tracker_options.max_wait_for_mapping_ms = options.sequential ? 0.0 : options.max_wait_for_mapping_ms;
   tracker_options.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   if (options.sensor == io::SensorKind::kMonocular) {
@@ -71,7 +74,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
     tracker_options.local_map_radius_factor = 1.0;  // ORB-SLAM2's window for monocular local-map tracking
     // Monocular boxes hide the background behind a person too (no depth to keep it), so more of their
     // keypoints are static: a pose from box keypoints needs the ordinary 30 inliers, not 50 (measured on
-    // bonn_crowd: 98.9 % against 97.1 % tracked; with depth, 30 let a synthetic crowd track people).
+    // bonn_crowd: 98.9 % against 97.1 % tracked).
     tracker_options.box_rescue_min_inliers = 30;
   }
   if (options.sensor == io::SensorKind::kStereo) {
@@ -89,6 +92,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracker_options.dynamic.region_depth_m = g.region_depth_m;
   tracker_options.dynamic.region_depth_ratio = g.region_depth_ratio;
   tracker_options.dynamic.region_steps = g.region_steps;
+  box_keypoints_ = tracker_options.box_keypoints;
   tracker_ = std::make_unique<tracking::Tracker>(tracker_options, map_, mapper_.get());
   if (vocabulary_) {
     keyframe_database_ = std::make_unique<loop::KeyframeDatabase>();
@@ -236,7 +240,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   std::vector<long> filtered_index;
   std::vector<int> box_of;
   if (people_) {
-    if (settings_.people_filter.static_in_boxes) {
+    if (box_keypoints_) {
       unfiltered.emplace(tracking::RawFeatures{raw.keys, raw.descriptors.clone(), raw.right_u, raw.depth_m});
     }
     PeopleFrame p = people_->filter(frame_index, images, raw, options_.record_keypoints);

@@ -189,6 +189,7 @@ class System {
   std::unique_ptr<StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
+  bool box_keypoints_ = false;  // the keypoints the people filter removes are offered to tracking (Tracker::BoxKeypoints)
   std::vector<TrajectoryRecord> records_;
   std::vector<MapSegment> segments_;           // the last one is the current map
   io::Trajectory past_keyframes_;              // keyframes of maps that were reset

@@ -27,9 +27,12 @@ namespace {
 // person (a false positive on a wall, a person who hides nothing but background in their box). Its
 // keypoints are released (no longer in_box), so they become map points like any other; if the box did
 // hold a person who moves later, the dynamic check culls what was made of them. Returns how many boxes.
-int release_static_boxes(map::Frame& frame, const std::vector<int>& box_of, const std::vector<bool>& disagrees) {
+// `flow`: per keypoint without a map point, +1 / -1 when its match to the last frame's box keypoints (with
+// depth) agrees / disagrees with the pose (box_flow_evidence), 0 = none.
+int release_static_boxes(map::Frame& frame, const std::vector<int>& box_of, const std::vector<bool>& disagrees,
+                         const std::vector<int8_t>& flow) {
   struct Count {
-    int keypoints = 0, matched = 0, inliers = 0;
+    int keypoints = 0, matched = 0, inliers = 0, flow_in = 0, flow_out = 0;
   };
   std::unordered_map<int, Count> counts;
   for (size_t i = 0; i < frame.size(); ++i) {
@@ -38,13 +41,19 @@ int release_static_boxes(map::Frame& frame, const std::vector<int>& box_of, cons
     ++c.keypoints;
     if (disagrees[i]) ++c.matched;
     const auto& p = frame.map_points[i];
-    if (!p || p->num_observations() < 1) continue;
+    if (!p || p->num_observations() < 1) {
+      if (flow[i] > 0) ++c.flow_in;
+      if (flow[i] < 0) ++c.flow_out;
+      continue;
+    }
     ++c.matched;
     if (!frame.outliers[i] && !frame.dynamic[i]) ++c.inliers;
   }
   int released = 0;
   for (const auto& [box, c] : counts) {
-    if (c.inliers < 20 || c.inliers < 0.7 * c.matched || c.inliers < 0.05 * c.keypoints) continue;
+    const bool by_map = c.inliers >= 20 && c.inliers >= 0.7 * c.matched && c.inliers >= 0.05 * c.keypoints;
+    const bool by_flow = c.flow_in >= 20 && c.flow_in >= 0.85 * (c.flow_in + c.flow_out) && c.flow_in >= 0.25 * c.keypoints;
+    if (!by_map && !by_flow) continue;
     ++released;
     for (size_t i = 0; i < frame.size(); ++i) {
       if (box_of[i] == box) frame.in_box[i] = false;
@@ -58,6 +67,7 @@ int release_static_boxes(map::Frame& frame, const std::vector<int>& box_of, cons
 std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, bool tracked,
                                                       const BoxKeypoints& boxes, int& static_boxes) {
   if (!tracked && !(velocity_ && last_frame_ && last_frame_->cam_from_world)) return std::nullopt;
+  if (!tracked && !options_.box_rescue) return std::nullopt;
 
   if (local_points_.empty()) return std::nullopt;
   auto features = boxes.features();
@@ -95,8 +105,7 @@ std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, b
     if (p->num_observations() < options_.box_min_observations || p->motion_score() > 1) continue;
     if (auto projection = full.project(*p, 0.5)) projected.push_back({p, *projection});
   }
-  if (projected.empty()) return std::nullopt;
-  match::search_local_points(full, projected, options_.local_map_radius_factor);
+  if (!projected.empty()) match::search_local_points(full, projected, options_.local_map_radius_factor);
 
   int new_in_box = 0;
   std::vector<bool> disagrees(full.size(), false);
@@ -113,19 +122,23 @@ std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, b
     }
     if (full.in_box[i]) ++new_in_box;
   }
-  if (new_in_box == 0) return std::nullopt;
+  if (new_in_box == 0 && !tracked) return std::nullopt;
 
-  optimize_pose(full);
+  if (new_in_box > 0) optimize_pose(full);
   const int after = count_tracked_in_map(full);
-  // Tracked: the box keypoints must add to what the filtered frame had; failed: as many inliers as a
-  // pose from a new set of matches needs (ORB-SLAM's 50 after relocalisation).
-  if (tracked ? after <= before : after < options_.box_rescue_min_inliers) return std::nullopt;
+  // Tracked: the box keypoints must not lose what the filtered frame had; failed: as many inliers as a
+  // pose from a new set of matches needs (ORB-SLAM's 50 after relocalisation; 30 in monocular).
+  if (tracked ? after < before : after < options_.box_rescue_min_inliers) return std::nullopt;
+  std::vector<int8_t> flow(full.size(), 0);
+  box_flow_evidence(full, flow);
+  static_boxes = release_static_boxes(full, boxes.box_of, disagrees, flow);
+  remember_box_frame(full);
+  if (new_in_box == 0 && static_boxes == 0) return std::nullopt;  // nothing gained
   for (size_t i = 0; i < full.size(); ++i) {
     const auto& p = full.map_points[i];
     if (p && !had_match[i] && !full.outliers[i]) p->increase_found();
   }
   inliers_in_local_map_ = after;
-  static_boxes = release_static_boxes(full, boxes.box_of, disagrees);
   if (!tracked) update_local_map(full);
   full.reference_keyframe = reference_keyframe_;
   return full;
@@ -142,6 +155,45 @@ std::optional<map::Frame> Tracker::relocalize_with_box_keypoints(const map::Fram
   full.reference_keyframe = reference_keyframe_;
   if (!track_local_map(full)) return std::nullopt;
   return full;
+}
+
+void Tracker::remember_box_frame(const map::Frame& full) {
+  if (!full.camera->is_stereo() || !full.cam_from_world) return;  // the evidence needs depth
+  last_box_frame_.emplace(full.id, full.timestamp_s, full.camera, full.levels, full.features);
+  last_box_frame_->cam_from_world = full.cam_from_world;
+  last_box_frame_->in_box = full.in_box;
+}
+
+void Tracker::box_flow_evidence(const map::Frame& full, std::vector<int8_t>& flow) const {
+  // The last frame's box keypoints with depth, as points in the world (from the last pose), matched into
+  // this frame's box keypoints that have no map point: a static surface lands where the pose says, a
+  // person who walks does not. Evidence for release only; the pose never uses these matches.
+  if (!last_box_frame_ || last_box_frame_->id + 1 != full.id || !full.cam_from_world) return;
+  const map::Frame& last = *last_box_frame_;
+  const auto& lf = *last.features;
+  map::Frame probe(last.id, last.timestamp_s, last.camera, last.levels, last.features);
+  probe.cam_from_world = last.cam_from_world;
+  const geometry::SE3 world_from_last = last.cam_from_world->inverse();
+  int points = 0;
+  for (size_t i = 0; i < lf.size(); ++i) {
+    if (!last.in_box[i] || lf.depth_m.empty() || lf.depth_m[i] <= 0) continue;
+    const geometry::Vec2 pixel(lf.keys_un[i].pt.x, lf.keys_un[i].pt.y);
+    auto point = std::make_shared<map::MapPoint>(0, world_from_last * last.camera->unproject(pixel, lf.depth_m[i]),
+                                                 nullptr, last.id);
+    point->set_descriptor(lf.descriptor(i));
+    probe.map_points[i] = std::move(point);
+    ++points;
+  }
+  if (points == 0) return;
+  map::Frame target(full.id, full.timestamp_s, full.camera, full.levels, full.features);
+  target.cam_from_world = full.cam_from_world;
+  match::search_from_last_frame(target, probe, options_.motion_model_radius);
+  for (size_t i = 0; i < full.size(); ++i) {
+    const auto& p = target.map_points[i];
+    if (!p || !full.in_box[i] || full.map_points[i]) continue;
+    const MatchResidual r = match_residual(target, i, *p, *full.cam_from_world);
+    flow[i] = r.chi2 <= r.threshold ? 1 : -1;
+  }
 }
 
 }  // namespace crowdslam::tracking

@@ -52,6 +52,7 @@ void Tracker::reset() {
   lost_frames_ = 0;
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
+  last_box_frame_.reset();
   velocity_.reset();
   last_cam_from_reference_.reset();
   reference_keyframe_.reset();

@@ -57,6 +57,8 @@ struct TrackerOptions {
   int box_check_below = 150;
   int box_min_observations = 2;
   int box_rescue_min_inliers = 50;
+  // Whether box keypoints may track a frame the filtered keypoints failed on (System: monocular only).
+  bool box_rescue = true;
   optim::PoseOptimizerOptions pose;
   // Geometric dynamic check of the tracked keypoints (dynamic_check.h).
   DynamicCheckOptions dynamic;
@@ -151,6 +153,10 @@ class Tracker {
   // The frame with its keypoints in boxes back (see track); nullopt when they do not help.
   std::optional<map::Frame> with_box_keypoints(const map::Frame& frame, bool tracked, const BoxKeypoints& boxes,
                                                int& static_boxes);
+  // The last frame with its box keypoints (depth only), and the evidence its box keypoints give about this
+  // frame's: matched where the pose says (+1) or not (-1). See box_keypoints.cpp.
+  void remember_box_frame(const map::Frame& full);
+  void box_flow_evidence(const map::Frame& full, std::vector<int8_t>& flow) const;
   // Relocalisation of a lost frame with its keypoints in boxes back (see track); nullopt when it fails.
   std::optional<map::Frame> relocalize_with_box_keypoints(const map::Frame& frame, const BoxKeypoints& boxes);
 
@@ -176,6 +182,7 @@ class Tracker {
   bool map_loaded_ = false;
   bool localization_only_ = false;
   std::vector<std::shared_ptr<map::MapPoint>> temporal_points_;  // visual-odometry points of the last frame
+  std::optional<map::Frame> last_box_frame_;  // remember_box_frame
   std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
   std::vector<std::shared_ptr<map::MapPoint>> local_points_;
 };
