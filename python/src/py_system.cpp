@@ -10,6 +10,7 @@
 #include <set>
 
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 #include "py_arrays.h"
 #include "py_gil.h"
 
@@ -25,15 +26,6 @@ std::set<PySystem*>& registry() {
 }
 
 std::string size_text(cv::Size size) { return std::to_string(size.width) + "x" + std::to_string(size.height); }
-
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buffer[32];
-  std::strftime(buffer, sizeof(buffer), "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buffer;
-}
 
 }  // namespace
 

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ctime>
 
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
@@ -40,4 +41,19 @@ TEST(Text, ReadLinesStripsCarriageReturns) {
   const auto lines = read_lines((tmp / "a.txt").string());
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0], "x");
+}
+
+TEST(Text, UtcNowIsTheCurrentTimeInTheGivenFormat) {
+  const std::time_t before = std::time(nullptr);
+  const std::string iso = utc_now();
+  const std::time_t after = std::time(nullptr);
+  ASSERT_EQ(iso.size(), 20u) << iso;  // 2026-12-02T16:20:00Z
+  std::tm tm{};
+  ASSERT_NE(strptime(iso.c_str(), "%Y-%m-%dT%H:%M:%SZ", &tm), nullptr) << iso;
+  const std::time_t parsed = timegm(&tm);
+  EXPECT_GE(parsed, before);
+  EXPECT_LE(parsed, after);
+  const std::string report = utc_now("%Y-%m-%d %H:%M UTC");
+  EXPECT_EQ(report.substr(0, 10), iso.substr(0, 10));
+  EXPECT_EQ(report.substr(report.size() - 4), " UTC");
 }

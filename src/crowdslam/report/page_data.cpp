@@ -10,6 +10,7 @@
 
 #include "crowdslam/eval/unique_stamps.h"
 #include "crowdslam/report/json_fields.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::report {
 
@@ -37,15 +38,6 @@ nlohmann::json positions_json(const io::Trajectory& trajectory, double t0) {
           {"x", rounded_array(x, 1e-4)},
           {"y", rounded_array(y, 1e-4)},
           {"z", rounded_array(z, 1e-4)}};
-}
-
-std::string utc_now() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &tm);
-  return text;
 }
 
 double first_stamp(const RunData& run) {
@@ -321,7 +313,7 @@ nlohmann::json page_data(const std::vector<RunData>& runs, const FrameStripOptio
   std::string title = "crowdslam report: ";
   for (size_t k = 0; k < runs.size(); ++k) title += (k > 0 ? " vs " : "") + runs[k].label;
   doc["title"] = title;
-  doc["generated"] = utc_now();
+  doc["generated"] = utc_now("%Y-%m-%d %H:%M UTC");
   // Views follow the first run's ground truth, or its (unaligned) trajectory without one.
   io::Trajectory reference;
   if (!runs.empty()) {

@@ -12,6 +12,7 @@
 #include "crowdslam/eval/ate.h"
 #include "crowdslam/eval/rpe.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::run {
 
@@ -20,14 +21,6 @@ nlohmann::json optional_json(const std::optional<double>& value) {
   return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
 }
 
-std::string utc_now() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
 }  // namespace
 
 std::string dataset_path(const std::string& spec) {

@@ -1,5 +1,7 @@
 #include "crowdslam/util/text.h"
 
+#include <ctime>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -81,6 +83,15 @@ std::string clip_text(std::string_view text, size_t max_chars) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
   }
   return result;
+}
+
+std::string utc_now(const char* format) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[64];
+  const size_t n = std::strftime(text, sizeof text, format, &tm);
+  return std::string(text, n);
 }
 
 }  // namespace crowdslam

@@ -19,6 +19,9 @@ std::vector<std::string> read_lines(const std::string& path);
 
 std::string trim(std::string_view text);
 
+// The current time in UTC, formatted by strftime (default ISO 8601, e.g. "2026-12-02T16:20:00Z").
+std::string utc_now(const char* format = "%Y-%m-%dT%H:%M:%SZ");
+
 // User text quoted in a message: `text` itself when it has at most `max_chars` characters; otherwise its
 // start and its end (where a path keeps its file name) joined by "...", `max_chars` characters in all,
 // and the full length, e.g. "/very/long/dir...rgb/1.png (2097152 chars)". Control characters become '?'.
