@@ -225,6 +225,10 @@ run_sanitizer() {
     "$bin" run --dataset "$seq" --out "$out/run_gt" --overwrite --detections "$seq/people_gt.txt" || true
   run_step "$tag run synth (detector)" "$out/run_detector.log" \
     "$bin" run --dataset "$seq" --out "$out/run_detector" --overwrite || true
+  # Box keypoints with depth (PeopleFilter.static_in_boxes "always"; the RGB-D default leaves them out).
+  { cat "$seq/settings.yaml"; printf '\nPeopleFilter.static_in_boxes: "always"\n'; } >"$out/always.yaml"
+  run_step "$tag run synth (detector, box keypoints always)" "$out/run_boxes.log" \
+    "$bin" run --dataset "$seq" --settings "$out/always.yaml" --out "$out/run_boxes" --overwrite || true
   run_step "$tag run synth (no people filter)" "$out/run_nofilter.log" \
     "$bin" run --dataset "$seq" --out "$out/run_nofilter" --overwrite --no-people-filter || true
   run_step "$tag run synth with the live viewer and three clients" "$out/run_viewer.log" \
