@@ -8,8 +8,10 @@
 // that projects here". When the filtered frame tracked, a match is kept only if it agrees with that pose
 // (the pose optimisation's 95 % chi-square threshold); a person in front of the point does not look like it,
 // and one who moves does not agree. When the filtered frame failed, the motion model's pose is the guess
-// and the pose optimisation's chi-square classification decides. Nothing new in the map is made of the
-// keypoints in boxes (Frame::in_box; Tracker::create_new_keyframe and update_last_frame leave them out).
+// and the pose optimisation's chi-square classification decides. A box the evidence shows static (its
+// map matches, or with depth the last frame's box keypoints landing where the pose says) is released and
+// mapped; nothing new in the map is made of any other box keypoint (Frame::in_box;
+// Tracker::create_new_keyframe and update_last_frame leave them out).
 #include <unordered_map>
 #include <unordered_set>
 
@@ -173,15 +175,10 @@ void Tracker::box_flow_evidence(const map::Frame& full, std::vector<int8_t>& flo
   const auto& lf = *last.features;
   map::Frame probe(last.id, last.timestamp_s, last.camera, last.levels, last.features);
   probe.cam_from_world = last.cam_from_world;
-  const geometry::SE3 world_from_last = last.cam_from_world->inverse();
   int points = 0;
   for (size_t i = 0; i < lf.size(); ++i) {
     if (!last.in_box[i] || lf.depth_m.empty() || lf.depth_m[i] <= 0) continue;
-    const geometry::Vec2 pixel(lf.keys_un[i].pt.x, lf.keys_un[i].pt.y);
-    auto point = std::make_shared<map::MapPoint>(0, world_from_last * last.camera->unproject(pixel, lf.depth_m[i]),
-                                                 nullptr, last.id);
-    point->set_descriptor(lf.descriptor(i));
-    probe.map_points[i] = std::move(point);
+    probe.map_points[i] = point_from_depth(last, i);
     ++points;
   }
   if (points == 0) return;

@@ -65,4 +65,13 @@ MatchResidual match_residual(const map::Frame& frame, size_t i, const map::MapPo
   return r;
 }
 
+std::shared_ptr<map::MapPoint> point_from_depth(const map::Frame& frame, size_t i) {
+  const auto& f = *frame.features;
+  const geometry::Vec2 pixel(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
+  const geometry::Vec3 world = frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[i]);
+  auto point = std::make_shared<map::MapPoint>(0, world, nullptr, frame.id);
+  point->set_descriptor(f.descriptor(i));
+  return point;
+}
+
 }  // namespace crowdslam::tracking

@@ -23,6 +23,11 @@ struct MatchResidual {
   double chi2 = 0;
   double threshold = kMatchChi2Mono;  // the 95 % chi-square threshold for its degrees of freedom
 };
+// A point for one frame only (no keyframe, id 0) where keypoint i's depth places it, with its descriptor:
+// the visual-odometry points of the motion model and the box keypoints' frame-to-frame evidence.
+// Requires frame.cam_from_world and a depth for i.
+std::shared_ptr<map::MapPoint> point_from_depth(const map::Frame& frame, size_t i);
+
 MatchResidual match_residual(const map::Frame& frame, size_t i, const map::MapPoint& point, const geometry::SE3& pose);
 
 }  // namespace crowdslam::tracking

@@ -146,11 +146,12 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       result.dynamic.skipped = skipped;
       inliers_in_local_map_ = count_tracked_in_map(frame);
     }
-    if (ok) {
+    if (ok && boxes.box_of.size() == frame.size()) {  // the frame has its box keypoints back
       for (size_t i = 0; i < frame.size(); ++i) {
-        const bool boxed = !boxes.box_of.empty() && boxes.box_of.size() == frame.size() && boxes.box_of[i] >= 0;
-        if (boxed && frame.map_points[i] && !frame.outliers[i] && !frame.dynamic[i]) ++result.box_matches;
+        if (boxes.box_of[i] >= 0 && frame.map_points[i] && !frame.outliers[i] && !frame.dynamic[i]) ++result.box_matches;
       }
+    }
+    if (ok) {
       lost_frames_ = 0;
       if (last_frame_ && last_frame_->cam_from_world) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
@@ -308,12 +309,8 @@ void Tracker::update_last_frame() {
   for (const auto& [depth, i] : by_depth) {
     auto& slot = last.map_points[i];
     if (!slot || slot->num_observations() < 1) {
-      const geometry::Vec2 pixel(f.keys_un[i].pt.x, f.keys_un[i].pt.y);
-      const geometry::Vec3 world = last.cam_from_world->inverse() * last.camera->unproject(pixel, depth);
-      auto point = std::make_shared<map::MapPoint>(0, world, nullptr, last.id);
-      point->set_descriptor(f.descriptor(i));
-      slot = point;
-      temporal_points_.push_back(point);
+      slot = point_from_depth(last, i);
+      temporal_points_.push_back(slot);
     }
     ++created;
     if (depth > options_.close_depth_m && created > 100) break;
