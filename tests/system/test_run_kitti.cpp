@@ -1,6 +1,7 @@
 // Monocular SLAM on real forward motion (issue 11): KITTI odometry 07, the first 100 frames (a car
 // accelerating to 8.5 m/s through a town), in sequential mode so the run is reproducible. The map is
-// initialised once and never reset, every frame from the initialisation on is tracked, and the Sim3 ATE
+// initialised once and never reset, every frame is tracked (those before the initialisation localised in
+// the new map afterwards), and the Sim3 ATE
 // stays within 0.65 % of the 54 m travelled (the issue's target for the threaded mode is 0.5 %, 0.27 m:
 // not met yet, see docs/RESULTS.md).
 #include <gtest/gtest.h>
@@ -32,9 +33,17 @@ TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
   EXPECT_LE(*summary.init_frame, 10u);
   EXPECT_EQ(summary.json["summary"]["map_resets"], 0);
   EXPECT_EQ(summary.segments.size(), 1u);
-  // From the initialisation on (and its reference frame), every frame.
-  EXPECT_EQ(summary.tracked, summary.frames - *summary.init_frame + 1);
-  EXPECT_GE(summary.tracked_percent, 95.0);
+  // From the initialisation on (and its reference frame), every frame; and the frames the initializer saw
+  // before it, localised in the new map afterwards (the car barely moves there: all of them).
+  // (The initializer's reference frame, the first keyframe, is one of them.)
+  EXPECT_EQ(summary.frames_localized_before_init, *summary.init_frame);
+  EXPECT_EQ(summary.tracked, summary.frames - *summary.init_frame + summary.frames_localized_before_init);
+  EXPECT_EQ(summary.tracked, summary.frames);
+  const auto& frames = summary.json["frames"];
+  for (size_t i = 0; i < *summary.init_frame; ++i) {
+    EXPECT_EQ(frames[i]["state"], "not_initialized") << i;  // its own report, made before the map existed
+    EXPECT_TRUE(frames[i]["localized_after_init"].get<bool>()) << i;
+  }
   ASSERT_TRUE(summary.ate_rmse_m.has_value());
   EXPECT_LT(*summary.ate_rmse_m, 0.35);
   std::printf("[ measured ] kitti07_head sequential: %zu/%zu tracked, ATE %.3f m, %d keyframes\n", summary.tracked,

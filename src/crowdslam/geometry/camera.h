@@ -82,6 +82,19 @@ struct PinholeCamera {
   // Without distortion the input is returned unchanged (no OpenCV call).
   [[nodiscard]] std::vector<cv::Point2f> undistort_points(const std::vector<cv::Point2f>& pixels) const;
   [[nodiscard]] std::vector<Vec2> undistort_points(const std::vector<Vec2>& pixels) const;
+  // The raw (distorted) pixel of an undistorted one: the plumb-bob model applied forwards (closed form,
+  // the inverse of undistort_points). Without distortion the input is returned unchanged.
+  [[nodiscard]] Vec2 distort_pixel(const Vec2& undistorted) const {
+    if (distortion.is_zero()) return undistorted;
+    const double x = (undistorted.x() - cx) / fx;
+    const double y = (undistorted.y() - cy) / fy;
+    const double r2 = x * x + y * y;
+    const Distortion& d = distortion;
+    const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+    const double xd = x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
+    const double yd = y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
+    return {fx * xd + cx, fy * yd + cy};
+  }
 
   // Bounds of the undistorted image: the four image corners are undistorted and the extreme
   // coordinates taken (left from the left corners, right from the right ones, etc.).

@@ -98,7 +98,10 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("Geometry.region_radius_px"), s.geometry.region_radius_px);
   set_if(r.real("Geometry.region_depth_m"), s.geometry.region_depth_m);
   set_if(r.real("Geometry.region_depth_ratio"), s.geometry.region_depth_ratio);
+  set_if(r.real("Geometry.free_space_margin_m"), s.geometry.free_space_margin_m);
+  set_if(r.real("Geometry.free_space_ratio"), s.geometry.free_space_ratio);
   set_if(r.integer("Geometry.region_steps"), s.geometry.region_steps);
+  set_if(r.integer("Geometry.free_space_cull_run"), s.geometry.free_space_cull_run);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
   set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
   set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);
@@ -186,7 +189,8 @@ bool operator==(const Settings& a, const Settings& b) {
                         ga.certain_factor == gb.certain_factor && ga.dynamic_score == gb.dynamic_score &&
                         ga.cull_score == gb.cull_score && ga.region_radius_px == gb.region_radius_px &&
                         ga.region_depth_m == gb.region_depth_m && ga.region_depth_ratio == gb.region_depth_ratio &&
-                        ga.region_steps == gb.region_steps;
+                        ga.region_steps == gb.region_steps && ga.free_space_margin_m == gb.free_space_margin_m &&
+                        ga.free_space_ratio == gb.free_space_ratio && ga.free_space_cull_run == gb.free_space_cull_run;
   const bool budget = a.feature_budget.enabled == b.feature_budget.enabled &&
                       a.feature_budget.thresholds == b.feature_budget.thresholds &&
                       a.feature_budget.factors == b.feature_budget.factors &&

@@ -112,6 +112,11 @@ struct GeometrySettings {
   double region_depth_m = 0.15;    // region growing depth tolerance (or region_depth_ratio x depth)
   double region_depth_ratio = 0.08;
   int region_steps = 2;
+  // RGB-D free-space test (tracking/dynamic_check.h): a point the depth image sees through by more than
+  // max(margin, ratio x z) gets a moving verdict; culled after free_space_cull_run of them in a row.
+  double free_space_margin_m = 0.2;  // 0 = off
+  double free_space_ratio = 0.1;
+  int free_space_cull_run = 2;
 };
 
 struct FeatureBudgetSettings {

@@ -209,6 +209,12 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(g.region_depth_ratio) && g.region_depth_ratio >= 0, "Geometry.region_depth_ratio", ">= 0",
             g.region_depth_ratio);
   c.require(g.region_steps >= 0 && g.region_steps <= 10, "Geometry.region_steps", "in [0, 10]", g.region_steps);
+  c.require(std::isfinite(g.free_space_margin_m) && g.free_space_margin_m >= 0, "Geometry.free_space_margin_m",
+            ">= 0 (0 = off)", g.free_space_margin_m);
+  c.require(std::isfinite(g.free_space_ratio) && g.free_space_ratio >= 0, "Geometry.free_space_ratio", ">= 0",
+            g.free_space_ratio);
+  c.require(g.free_space_cull_run >= 1 && g.free_space_cull_run <= 8, "Geometry.free_space_cull_run", "in [1, 8]",
+            g.free_space_cull_run);
   const auto& b = s.feature_budget;
   if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
   for (std::size_t i = 0; i < b.thresholds.size(); ++i) {

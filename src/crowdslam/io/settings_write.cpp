@@ -114,7 +114,10 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nGeometry.region_radius_px: " << real_text(g.region_radius_px)
       << "\nGeometry.region_depth_m: " << real_text(g.region_depth_m)
       << "\nGeometry.region_depth_ratio: " << real_text(g.region_depth_ratio)
-      << "\nGeometry.region_steps: " << g.region_steps << "\n\n";
+      << "\nGeometry.region_steps: " << g.region_steps
+      << "\nGeometry.free_space_margin_m: " << real_text(g.free_space_margin_m)
+      << "\nGeometry.free_space_ratio: " << real_text(g.free_space_ratio)
+      << "\nGeometry.free_space_cull_run: " << g.free_space_cull_run << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "

@@ -49,6 +49,11 @@ class Frame {
   std::vector<bool> in_box;
   std::optional<geometry::SE3> cam_from_world;
   std::shared_ptr<KeyFrame> reference_keyframe;
+  // RGB-D: the frame's raw depth image (CV_16UC1 at raw, distorted pixels; 0 = no depth) and the metres
+  // one unit stands for, for the dynamic check's free-space test. Empty for monocular and stereo. Shared
+  // with the caller's image (cv::Mat reference count), never written.
+  cv::Mat depth_raw;
+  double depth_metres_per_unit = 0;
 
   [[nodiscard]] size_t size() const { return features->size(); }
   [[nodiscard]] geometry::Vec3 camera_center() const { return cam_from_world->inverse().translation(); }

@@ -201,6 +201,13 @@ int MapPoint::record_motion(bool moving) {
   return __builtin_popcount(motion_bits_);
 }
 
+int MapPoint::moving_run() const {
+  std::lock_guard lock(features_mutex_);
+  int run = 0;
+  while (run < kMotionWindow && ((motion_bits_ >> run) & 1u)) ++run;
+  return run;
+}
+
 int MapPoint::motion_score() const {
   std::lock_guard lock(features_mutex_);
   return __builtin_popcount(motion_bits_);

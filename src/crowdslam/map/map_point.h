@@ -71,6 +71,8 @@ class MapPoint {
   static constexpr int kMotionWindow = 8;
   int record_motion(bool moving);
   [[nodiscard]] int motion_score() const;
+  // How many of the newest verdicts in a row said "moving" (0-8).
+  [[nodiscard]] int moving_run() const;
 
   // Saved maps (mapdb/): the viewing geometry and statistics as stored, and their restoration on load.
   struct SavedState {

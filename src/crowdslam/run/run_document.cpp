@@ -57,6 +57,7 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"dynamic_grown", r.dynamic_grown},
           {"matches_moving", r.matches_moving},
           {"points_culled_moving", r.points_culled_moving},
+          {"points_seen_through", r.points_seen_through},
           {"dynamic_check_skipped", r.dynamic_check_skipped},
           {"stereo_matches", r.stereo_matches},
           {"right_keypoints_removed", r.right_keypoints_removed},
@@ -72,7 +73,8 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"state", tracking::to_string(r.state)},
           {"method", r.method},
           {"keyframe", r.new_keyframe},
-          {"waited_for_mapping_ms", r.waited_for_mapping_ms}};
+          {"waited_for_mapping_ms", r.waited_for_mapping_ms},
+          {"localized_after_init", false}};
 }
 
 nlohmann::json segment_json(const system::MapSegment& s) {
@@ -90,6 +92,7 @@ void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummar
   std::vector<double> tracking_ms, extraction_ms, total_ms;
   for (const auto& r : reports) {
     if (!summary.init_frame && r.method == std::string("init")) summary.init_frame = r.index;
+    summary.frames_localized_before_init += r.localized_before_init.size();
     tracking_ms.push_back(r.tracking_ms);
     extraction_ms.push_back(r.extraction_ms);
     total_ms.push_back(r.extraction_ms + r.detector_wait_ms + r.tracking_ms);
@@ -200,13 +203,14 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   long box_matches = 0;
   double waited_for_mapping_ms = 0;
   int frames_waited = 0;
-  long dynamic_total = 0, grown_total = 0, culled_total = 0;
+  long dynamic_total = 0, grown_total = 0, culled_total = 0, seen_through_total = 0;
   int frames_with_dynamic = 0;
   int frames_check_skipped = 0;
   for (const auto& r : reports) {
     dynamic_total += r.keypoints_dynamic;
     grown_total += r.dynamic_grown;
     culled_total += r.points_culled_moving;
+    seen_through_total += r.points_seen_through;
     frames_with_dynamic += r.keypoints_dynamic > 0 ? 1 : 0;
     frames_check_skipped += r.dynamic_check_skipped ? 1 : 0;
     rescued += r.rescued_with_boxes ? 1 : 0;
@@ -249,15 +253,19 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                      {"moving_factor", g.moving_factor},
                      {"cull_score", g.cull_score},
                      {"region_radius_px", g.region_radius_px},
+                     {"free_space_margin_m", g.free_space_margin_m},
+                     {"free_space_cull_run", g.free_space_cull_run},
                      {"keypoints_dynamic", dynamic_total},
                      {"keypoints_grown", grown_total},
                      {"frames_with_dynamic", frames_with_dynamic},
                      {"map_points_culled_moving", culled_total},
+                     {"map_point_verdicts_seen_through", seen_through_total},
                      {"frames_tracked_without_check", frames_check_skipped}};
   doc["summary"] = {{"frames", summary.frames},
                     {"tracked_frames", summary.tracked},
                     {"tracked_percent", summary.tracked_percent},
                     {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
+                    {"frames_localized_before_init", summary.frames_localized_before_init},
                     {"wall_time_s", c.wall_s},
                     {"throughput_fps", summary.throughput_fps},
                     {"tracking_ms_median", summary.tracking_ms_median},
@@ -345,6 +353,13 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   doc["accuracy"] = accuracy;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& r : reports) frames.push_back(frame_json(r));
+  // Frames the monocular initialisation localised afterwards: tracked (they have a pose in the
+  // trajectory) although their own report, made before the map existed, says not initialised.
+  for (const auto& r : reports) {
+    for (const size_t index : r.localized_before_init) {
+      if (index < frames.size()) frames[index]["localized_after_init"] = true;
+    }
+  }
   doc["frames"] = std::move(frames);
   return doc;
 }

@@ -46,6 +46,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   builder_options.orb.ini_th_fast = settings.orb.ini_th_fast;
   builder_options.orb.min_th_fast = settings.orb.min_th_fast;
   builder_options.depth_map_factor = settings.depth_map_factor > 0 ? settings.depth_map_factor : 1.0;
+  depth_map_factor_ = builder_options.depth_map_factor;
   load_vocabulary();
   // Frames get their bag of words from tracking, only when needed (tracking/frame_bow.h).
   frame_builder_ = std::make_unique<tracking::FrameBuilder>(camera_, builder_options);
@@ -92,6 +93,9 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracker_options.dynamic.region_depth_m = g.region_depth_m;
   tracker_options.dynamic.region_depth_ratio = g.region_depth_ratio;
   tracker_options.dynamic.region_steps = g.region_steps;
+  tracker_options.dynamic.free_space_margin_m = g.free_space_margin_m;
+  tracker_options.dynamic.free_space_ratio = g.free_space_ratio;
+  tracker_options.dynamic.free_space_cull_run = g.free_space_cull_run;
   box_keypoints_ = tracker_options.box_keypoints;
   tracker_ = std::make_unique<tracking::Tracker>(tracker_options, map_, mapper_.get());
   if (vocabulary_) {
@@ -274,6 +278,10 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
 
   const auto tracking_start = std::chrono::steady_clock::now();
   map::Frame frame(next_frame_id_++, timestamp_s, camera_, frame_builder_->levels(), std::move(features));
+  if (options_.sensor == io::SensorKind::kRgbd) {
+    frame.depth_raw = images.depth;
+    frame.depth_metres_per_unit = 1.0 / depth_map_factor_;
+  }
   tracking::Tracker::BoxKeypoints box_keypoints;
   if (unfiltered && filtered_index.size() == unfiltered->keys.size()) {
     box_keypoints.filtered_index = std::move(filtered_index);
@@ -306,6 +314,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   report.dynamic_grown = result.dynamic.grown;
   report.matches_moving = result.dynamic.moving;
   report.points_culled_moving = result.dynamic.points_culled;
+  report.points_seen_through = result.dynamic.free_space;
   report.dynamic_check_skipped = result.dynamic.skipped;
   report.tracked_points = result.tracked_points;
 
@@ -336,14 +345,21 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
                              : std::vector<std::shared_ptr<map::KeyFrame>>{};
   if (!keyframes.empty() && keyframes.front()->frame_id < records_.size()) {
     const auto& first = keyframes.front();
-    TrajectoryRecord& initial = records_[first->frame_id];
-    if (!initial.tracked && initial.segment == map_resets_) {
-      initial.tracked = true;
-      initial.reference = first;
-      initial.cam_from_reference = geometry::SE3();
-      initial.world_from_cam = first->world_from_cam();
-      ++segments_.back().tracked;
-      segments_.back().first_stamp_s = initial.timestamp_s;
+    // The earlier frames the new map localised (TrackResult::recovered_before_init), and the reference.
+    auto recovered = result.recovered_before_init;
+    recovered.emplace_back(first->frame_id, first->cam_from_world());
+    for (const auto& [frame_id, cam_from_world] : recovered) {
+      if (frame_id >= records_.size()) continue;
+      TrajectoryRecord& earlier = records_[frame_id];
+      if (earlier.tracked || earlier.segment != map_resets_) continue;
+      earlier.tracked = true;
+      earlier.reference = first;
+      earlier.cam_from_reference = cam_from_world * first->world_from_cam();
+      earlier.world_from_cam = cam_from_world.inverse();
+      MapSegment& current = segments_.back();
+      if (current.tracked++ == 0 || earlier.timestamp_s < current.first_stamp_s) current.first_stamp_s = earlier.timestamp_s;
+      if (earlier.timestamp_s > current.last_stamp_s) current.last_stamp_s = earlier.timestamp_s;
+      report.localized_before_init.push_back(frame_id);
     }
   }
   for (auto* observer : observers_) observer->on_frame(report, world_from_cam, images);

@@ -63,6 +63,10 @@ struct FrameReport {
   tracking::TrackingState state = tracking::TrackingState::kNotInitialized;
   std::string method;
   bool new_keyframe = false;
+  // Monocular initialisation: the earlier frames the new map gave a pose afterwards (the initializer's
+  // reference frame, now the first keyframe, and those localised in the map); they count as tracked in
+  // the trajectory and the summary, not in their own report.
+  std::vector<size_t> localized_before_init;  // their indices
   double waited_for_mapping_ms = 0;  // part of tracking_ms: waiting for local mapping to take a keyframe
   // People filter.
   int person_boxes = 0;
@@ -81,6 +85,7 @@ struct FrameReport {
   int dynamic_grown = 0;
   int matches_moving = 0;
   int points_culled_moving = 0;
+  int points_seen_through = 0;  // RGB-D: unmatched local map points the depth image sees through (free space)
   bool dynamic_check_skipped = false;  // failed with the check, tracked without it
   int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
@@ -189,6 +194,7 @@ class System {
   std::unique_ptr<StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
+  double depth_map_factor_ = 1.0;  // RGB-D raw depth units per metre
   bool box_keypoints_ = false;  // the keypoints the people filter removes are offered to tracking (Tracker::BoxKeypoints)
   std::vector<TrajectoryRecord> records_;
   std::vector<MapSegment> segments_;           // the last one is the current map

@@ -48,6 +48,16 @@ struct DynamicCheckOptions {
   // other matches that disagree with it are left out of the full optimisation (0 = off).
   int trusted_observations = 6;
   int min_trusted = 30;
+  // Free-space test (RGB-D): a map point of the local map that projects into the frame but is not
+  // matched, where the depth image sees a surface farther than the point by more than
+  // max(free_space_margin_m, free_space_ratio * z) over the whole window around its projection, cannot
+  // be there (the camera sees through it): a moving verdict for the point. A mover's points, once it has
+  // moved on, are never matched again, so only this test gets them culled (0 = off).
+  double free_space_margin_m = 0.2;
+  double free_space_ratio = 0.1;
+  // A point seen through this many times in a row (no matched observation in between) is culled: it has
+  // moved, or it never was where the map has it.
+  int free_space_cull_run = 2;
   void check() const;
 };
 
@@ -56,7 +66,8 @@ struct DynamicCheckStats {
   int moving = 0;          // of those, judged moving in this frame
   int dynamic = 0;         // keypoints dynamic after the check (region growth included)
   int grown = 0;           // of those, added by region growing
-  int points_culled = 0;   // map points culled as moving
+  int points_culled = 0;   // map points culled as moving (by the verdicts and the free-space test)
+  int free_space = 0;      // unmatched local map points the depth image sees through (free_space())
   bool skipped = false;    // the frame failed with the check and was tracked without it (Tracker::track)
 };
 
@@ -81,8 +92,15 @@ class DynamicCheck {
   // points' scores, culls map points seen moving repeatedly, and grows regions. `last` may be null.
   DynamicCheckStats update(map::Frame& frame, const map::Frame* last);
 
+  // After update(), RGB-D only (frame.depth_raw): the free-space test (options above) of the local map
+  // points not matched in this frame; records their moving verdicts and culls as update() does.
+  void free_space(const map::Frame& frame, const std::vector<std::shared_ptr<map::MapPoint>>& local_points,
+                  DynamicCheckStats& stats) const;
+
  private:
   void grow_regions(map::Frame& frame, const std::vector<bool>& judged, DynamicCheckStats& stats) const;
+  // Seen often enough (trusted_observations) and judged moving at most once in its last 8 checks.
+  [[nodiscard]] bool trusted_point(const map::MapPoint& point) const;
 
   DynamicCheckOptions options_;
   bool suspended_ = false;

@@ -61,6 +61,8 @@ void Tracker::reset() {
   local_keyframes_.clear();
   local_points_.clear();
   monocular_initializer_.reset();
+  frames_before_init_.clear();
+  recovered_before_init_.clear();
 }
 
 void Tracker::start_in_loaded_map(bool localization_only) {
@@ -80,6 +82,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       state_ = TrackingState::kOk;
       result.method = "init";
       result.new_keyframe = true;
+      result.recovered_before_init = std::move(recovered_before_init_);
+      recovered_before_init_.clear();
     }
   } else {
     bool ok = false;
@@ -144,6 +148,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       const bool skipped = result.dynamic.skipped;
       result.dynamic = dynamic_check_.update(frame, last_frame_ ? &*last_frame_ : nullptr);
       result.dynamic.skipped = skipped;
+      dynamic_check_.free_space(frame, local_points_, result.dynamic);
       inliers_in_local_map_ = count_tracked_in_map(frame);
     }
     if (ok && boxes.box_of.size() == frame.size()) {  // the frame has its box keypoints back
@@ -202,6 +207,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
   result.cam_from_world = state_ == TrackingState::kOk ? frame.cam_from_world : std::nullopt;
   result.reference_keyframe = frame.reference_keyframe;
   result.tracked_points = state_ == TrackingState::kOk ? inliers_in_local_map_ : 0;
+  frame.depth_raw.release();  // the caller's image: not kept beyond this call
   last_frame_ = std::move(frame);
   return result;
 }

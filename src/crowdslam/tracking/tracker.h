@@ -3,6 +3,7 @@
 // motion-model and reference-keyframe tracking, local-map tracking, and keyframe creation.
 // Runs on the caller's thread; hands keyframes to a KeyframeConsumer (the local mapper).
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -85,6 +86,10 @@ struct TrackResult {
   bool rescued_with_boxes = false;
   double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
   DynamicCheckStats dynamic;         // the geometric dynamic check of this frame (zeros when off or lost)
+  // Monocular initialisation (method "init"): the frames offered to the initializer before this one
+  // (since the last reset, at most kMaxFramesBeforeInit) that could be localised in the new map, as
+  // (frame id, cam_from_world). The initializer's reference frame is the first keyframe, not listed here.
+  std::vector<std::pair<uint64_t, geometry::SE3>> recovered_before_init;
 };
 
 class Tracker {
@@ -133,6 +138,10 @@ class Tracker {
  private:
   bool initialize(map::Frame& frame);
   bool initialize_monocular(map::Frame& frame);                   // tracker_monocular.cpp
+  // After a monocular initialisation from `init_frame`: the earlier frames in frames_before_init_ that
+  // the new map localises (tracker_monocular.cpp).
+  std::vector<std::pair<uint64_t, geometry::SE3>> localize_frames_before_init(const map::Frame& init_frame,
+                                                                             uint64_t reference_id);
   enum class KeyframeDecision { kNo, kInsert, kWaitForMapper };
   KeyframeDecision need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);
@@ -185,6 +194,10 @@ class Tracker {
   std::optional<map::Frame> last_box_frame_;  // remember_box_frame
   std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
   std::vector<std::shared_ptr<map::MapPoint>> local_points_;
+  // Monocular: the frames the initializer saw so far (localize_frames_before_init), oldest first.
+  static constexpr size_t kMaxFramesBeforeInit = 60;
+  std::deque<map::Frame> frames_before_init_;
+  std::vector<std::pair<uint64_t, geometry::SE3>> recovered_before_init_;  // of the initialising frame
 };
 
 }  // namespace crowdslam::tracking

@@ -4,8 +4,12 @@
 // map points come only from triangulation (two-view initialisation, then the local mapper).
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/tracking/frame_bow.h"
+#include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/tracking/tracker.h"
 
 namespace crowdslam::tracking {
@@ -15,7 +19,14 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
   // database, loop closing): computed before the initializer keeps a copy of the frame.
   if (vocabulary_) ensure_bow(frame, *vocabulary_);
   const auto init = monocular_initializer_.add_frame(frame);
-  if (!init) return false;
+  const auto remember = [&] {
+    frames_before_init_.push_back(frame);
+    if (frames_before_init_.size() > kMaxFramesBeforeInit) frames_before_init_.pop_front();
+  };
+  if (!init) {
+    remember();
+    return false;
+  }
   const auto keyframes = build_initial_map(*map_, *init, frame, options_.monocular_init);
   if (!keyframes) {
     // Not enough of the reconstruction survived: start again from this frame.
@@ -23,6 +34,7 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
     monocular_initializer_.add_frame(frame);
     frame.cam_from_world.reset();
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    remember();
     return false;
   }
   const auto& [first, second] = *keyframes;
@@ -36,8 +48,80 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
   local_points_ = map_->map_points();
   inliers_in_local_map_ = static_cast<int>(local_points_.size());
   velocity_.reset();  // the next frame is tracked against the reference keyframe
+  recovered_before_init_ = localize_frames_before_init(frame, init->reference->id);
+  frames_before_init_.clear();
   monocular_initializer_.reset();
   return true;
+}
+
+namespace {
+
+// The pose a fraction `t` of the way from `a` to `b` (camera centres on the line, rotations slerped).
+geometry::SE3 interpolate(const geometry::SE3& a, const geometry::SE3& b, double t) {
+  const geometry::SE3 wa = a.inverse();
+  const geometry::SE3 wb = b.inverse();
+  const Eigen::Quaterniond q = wa.rotation().slerp(t, wb.rotation());
+  const geometry::Vec3 c = (1 - t) * wa.translation() + t * wb.translation();
+  return geometry::SE3(q, c).inverse();
+}
+
+}  // namespace
+
+std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_init(const map::Frame& init_frame,
+                                                                                    uint64_t reference_id) {
+  // The frames the initializer saw before the frame that initialised: those after its reference frame
+  // lie between the two keyframes (first pose guess: interpolated by time), those before the reference
+  // are taken backwards from it (guess: the pose of the frame after, moved by the velocity between the
+  // two frames after). Each is matched by projection to the initial map, wide then narrow, and its pose
+  // optimised; it counts when it keeps the 50 inliers a pose from new matches needs (as relocalisation).
+  // Frames that fail are left lost; going backwards stops at the first failure.
+  constexpr int kMinInliers = 50;
+  std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
+  if (frames_before_init_.empty() || !init_frame.cam_from_world) return recovered;
+  const auto points = map_->map_points();
+  const auto reference_kf = map_->keyframes().front();  // sorted by id: the reference frame's keyframe
+  const geometry::SE3 first_pose = reference_kf->cam_from_world();
+  const geometry::SE3 last_pose = *init_frame.cam_from_world;
+  const double t0 = reference_kf->timestamp_s;
+  const double t1 = init_frame.timestamp_s;
+  const auto localize = [&](map::Frame frame, const geometry::SE3& guess) -> std::optional<geometry::SE3> {
+    frame.cam_from_world = guess;
+    for (const double radius_factor : {6.0, 1.5}) {
+      std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+      std::fill(frame.outliers.begin(), frame.outliers.end(), false);
+      std::vector<match::ProjectedPoint> projected;
+      for (const auto& p : points) {
+        if (!p || p->is_bad()) continue;
+        if (auto projection = frame.project(*p, 0.5)) projected.push_back({p, *projection});
+      }
+      match::search_local_points(frame, projected, radius_factor);
+      if (optimize_frame_pose(frame, options_.pose) < kMinInliers) return std::nullopt;
+    }
+    return frame.cam_from_world;
+  };
+  // Between the reference frame and the initialising frame.
+  for (const auto& frame : frames_before_init_) {
+    if (frame.id <= reference_id || t1 <= t0) continue;
+    const double t = std::clamp((frame.timestamp_s - t0) / (t1 - t0), 0.0, 1.0);
+    if (auto pose = localize(frame, interpolate(first_pose, last_pose, t))) recovered.emplace_back(frame.id, *pose);
+  }
+  // Before the reference frame, newest first.
+  geometry::SE3 later = first_pose;
+  std::optional<geometry::SE3> step;  // cam_from_world(earlier) * world_from_cam(later), as last measured
+  for (auto it = frames_before_init_.rbegin(); it != frames_before_init_.rend(); ++it) {
+    if (it->id >= reference_id) continue;
+    const geometry::SE3 guess = step ? *step * later : later;
+    const auto pose = localize(*it, guess);
+    if (!pose) break;
+    step = *pose * later.inverse();
+    later = *pose;
+    recovered.emplace_back(it->id, *pose);
+  }
+  std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (!recovered.empty()) {
+    spdlog::info("monocular initialisation: {} earlier frames localised in the new map", recovered.size());
+  }
+  return recovered;
 }
 
 Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame& frame) const {
