@@ -34,6 +34,7 @@ void TrackerOptions::check() const {
   if (!(close_depth_m > 0)) throw InputError("tracker: close depth (ThDepth) must be > 0");
   if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
   if (max_frames_between_keyframes < 1) throw InputError("tracker: max frames between keyframes must be >= 1");
+  if (keyframe_reference_min_observations < 1) throw InputError("tracker: keyframe_reference_min_observations must be >= 1");
   pose.check();
   dynamic.check();
   if (monocular) monocular_init.check();
@@ -486,7 +487,7 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
       num_keyframes > max_frames) {
     return KeyframeDecision::kNo;
   }
-  const int min_observations = num_keyframes <= 2 ? 2 : 3;
+  const int min_observations = num_keyframes <= 2 ? 2 : options_.keyframe_reference_min_observations;
   const int reference_matches = reference_keyframe_ ? reference_keyframe_->tracked_map_points(min_observations) : 0;
   const bool mapper_idle = mapper_->accepts_keyframes();
 

@@ -43,6 +43,13 @@ struct TrackerOptions {
   // A keyframe is due when the frame tracks fewer than this fraction of its reference keyframe's points
   // (ORB-SLAM2 uses 0.75 for RGB-D; more keyframes measured better, see docs/RESULTS.md).
   double keyframe_reference_ratio = 0.9;
+  // RGB-D / stereo: the reference keyframe's points counted for that ratio are those seen by at least
+  // this many keyframes (ORB-SLAM2: 3; 2 while the map has two keyframes; monocular keeps 3). With 3, a
+  // threaded run whose keyframes thin out counts ever fewer points (they need three keyframes to count, and
+  // the mapper culls points seen by fewer than three after two keyframes), so keyframes thin out further:
+  // on the synthetic rooms 24-26 keyframes in 300 frames against 110-136 sequential, at 3x the ATE
+  // (docs/DYNAMIC.md). With 2 the threaded rooms make 56-63.
+  int keyframe_reference_min_observations = 2;
   int reset_if_lost_within_keyframes = 5;  // lost with so few keyframes: reset the map and start again
   // Lost for this many frames in a row without relocalising: start a new map (0 = never; ORB-SLAM2 stays
   // lost until the camera returns, ORB-SLAM3's Atlas starts a new map at once). The camera is somewhere the
