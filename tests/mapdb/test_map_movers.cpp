@@ -59,6 +59,9 @@ TEST(GeometricCheck, MoversStayOutOfTheMapAndTheTrajectoryStaysAccurate) {
   EXPECT_EQ(without.keypoints_dynamic, 0);
   EXPECT_GT(with.on_movers.keyframes_with_mask, 5);
   EXPECT_GT(without.on_movers.points_on_mask, 0u) << "the movers are seen and mapped without the check";
+  // Sequential: 2.9 % (a keyframe every 1.2 frames here since RGB-D counts reference points with 2+
+  // observations; 1.05 % before that, 2.6 % before the free-space test). The 1 % is for the
+  // threaded median (0.63 %, docs/DYNAMIC.md).
   EXPECT_LE(with.on_movers.fraction(), 0.05) << "map points on movers";
   EXPECT_LE(with.ate_m, 0.01);
   EXPECT_LT(with.ate_m, without.ate_m);
