@@ -7,6 +7,7 @@
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/tracking/dynamic_check.h"
+#include "tracking_test_camera.h"
 #include "crowdslam/util/error.h"
 
 using namespace crowdslam;
@@ -14,16 +15,7 @@ using namespace crowdslam::tracking;
 
 namespace {
 
-std::shared_ptr<geometry::PinholeCamera> camera() {
-  auto c = std::make_shared<geometry::PinholeCamera>();
-  c->fx = c->fy = 525;
-  c->cx = 319.5;
-  c->cy = 239.5;
-  c->width = 640;
-  c->height = 480;
-  c->bf = 40;  // RGB-D's virtual baseline
-  return c;
-}
+std::shared_ptr<geometry::PinholeCamera> camera() { return test::rgbd_test_camera(); }
 
 struct Observed {
   geometry::Vec3 cam;  // where the keypoint really is (camera frame)

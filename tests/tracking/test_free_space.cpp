@@ -8,6 +8,7 @@
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/tracking/dynamic_check.h"
+#include "tracking_test_camera.h"
 
 using namespace crowdslam;
 using namespace crowdslam::tracking;
@@ -16,16 +17,7 @@ namespace {
 
 constexpr double kUnitsPerMetre = 5000.0;  // TUM / Bonn depth scale
 
-std::shared_ptr<geometry::PinholeCamera> camera() {
-  auto c = std::make_shared<geometry::PinholeCamera>();
-  c->fx = c->fy = 525;
-  c->cx = 319.5;
-  c->cy = 239.5;
-  c->width = 640;
-  c->height = 480;
-  c->bf = 40;
-  return c;
-}
+std::shared_ptr<geometry::PinholeCamera> camera() { return test::rgbd_test_camera(); }
 
 const auto kLevels = std::make_shared<map::ScaleLevels>(1.2f, 8);
 

@@ -46,7 +46,6 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   builder_options.orb.ini_th_fast = settings.orb.ini_th_fast;
   builder_options.orb.min_th_fast = settings.orb.min_th_fast;
   builder_options.depth_map_factor = settings.depth_map_factor > 0 ? settings.depth_map_factor : 1.0;
-  depth_map_factor_ = builder_options.depth_map_factor;
   load_vocabulary();
   // Frames get their bag of words from tracking, only when needed (tracking/frame_bow.h).
   frame_builder_ = std::make_unique<tracking::FrameBuilder>(camera_, builder_options);
@@ -280,7 +279,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   map::Frame frame(next_frame_id_++, timestamp_s, camera_, frame_builder_->levels(), std::move(features));
   if (options_.sensor == io::SensorKind::kRgbd) {
     frame.depth_raw = images.depth;
-    frame.depth_metres_per_unit = 1.0 / depth_map_factor_;
+    frame.depth_metres_per_unit = 1.0 / frame_builder_->depth_map_factor();
   }
   tracking::Tracker::BoxKeypoints box_keypoints;
   if (unfiltered && filtered_index.size() == unfiltered->keys.size()) {

@@ -194,7 +194,6 @@ class System {
   std::unique_ptr<StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
-  double depth_map_factor_ = 1.0;  // RGB-D raw depth units per metre
   bool box_keypoints_ = false;  // the keypoints the people filter removes are offered to tracking (Tracker::BoxKeypoints)
   std::vector<TrajectoryRecord> records_;
   std::vector<MapSegment> segments_;           // the last one is the current map

@@ -68,6 +68,7 @@ class FrameBuilder {
   [[nodiscard]] const std::shared_ptr<const map::ScaleLevels>& levels() const { return levels_; }
   [[nodiscard]] const std::shared_ptr<const geometry::PinholeCamera>& camera() const { return camera_; }
   [[nodiscard]] int default_num_features() const { return options_.orb.num_features; }
+  [[nodiscard]] double depth_map_factor() const { return options_.depth_map_factor; }  // raw units per metre
 
  private:
   std::shared_ptr<const geometry::PinholeCamera> camera_;
