@@ -90,6 +90,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
   set_if(r.text("PeopleFilter.static_in_boxes"), s.people_filter.static_in_boxes);
   set_if(r.integer("PeopleFilter.static_check_below"), s.people_filter.static_check_below);
+  set_if(r.real("PeopleFilter.flat_box_margin_m"), s.people_filter.flat_box_margin_m);
   set_if(r.flag("Geometry.dynamic_check"), s.geometry.dynamic_check);
   set_if(r.real("Geometry.moving_factor"), s.geometry.moving_factor);
   set_if(r.real("Geometry.certain_factor"), s.geometry.certain_factor);
@@ -182,7 +183,8 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.people_filter.mode == b.people_filter.mode &&
                       a.people_filter.margin_px == b.people_filter.margin_px &&
                       a.people_filter.depth_margin_m == b.people_filter.depth_margin_m &&
-                      a.people_filter.right_image == b.people_filter.right_image;
+                      a.people_filter.right_image == b.people_filter.right_image &&
+                      a.people_filter.flat_box_margin_m == b.people_filter.flat_box_margin_m;
   const auto& ga = a.geometry;
   const auto& gb = b.geometry;
   const bool geometry = ga.dynamic_check == gb.dynamic_check && ga.moving_factor == gb.moving_factor &&

@@ -99,6 +99,9 @@ struct PeopleFilterSettings {
   // (no depth mode to keep it); "always"; "never". Measured in docs/DETECTION.md.
   std::string static_in_boxes = "monocular";
   int static_check_below = 150;
+  // RGB-D: a box whose torso region is not closer than the surface around the box by more than this is
+  // flat (a poster, a wall photograph, a screen; people/box_depth.h) and filters nothing. 0 = off.
+  double flat_box_margin_m = 0.2;
 };
 
 // Geometric dynamic check of tracked keypoints against the static map (tracking/dynamic_check.h).

@@ -63,6 +63,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "PeopleFilter.right_image",
                                   "PeopleFilter.static_in_boxes",
                                   "PeopleFilter.static_check_below",
+                                  "PeopleFilter.flat_box_margin_m",
                                   "Geometry.dynamic_check",
                                   "Geometry.moving_factor",
                                   "Geometry.certain_factor",

@@ -105,7 +105,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
       << "\nPeopleFilter.right_image: " << quoted(p.right_image)
       << "\nPeopleFilter.static_in_boxes: " << quoted(p.static_in_boxes)
-      << "\nPeopleFilter.static_check_below: " << p.static_check_below << "\n\n";
+      << "\nPeopleFilter.static_check_below: " << p.static_check_below
+      << "\nPeopleFilter.flat_box_margin_m: " << real_text(p.flat_box_margin_m) << "\n\n";
   const auto& g = s.geometry;
   out << "# Geometric dynamic check of tracked keypoints\nGeometry.dynamic_check: " << (g.dynamic_check ? 1 : 0)
       << "\nGeometry.moving_factor: " << real_text(g.moving_factor)

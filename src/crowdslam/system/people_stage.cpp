@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "crowdslam/people/box_depth.h"
 #include "crowdslam/people/detector_setup.h"
 #include "crowdslam/people/dnn_detector.h"
 #include "crowdslam/people/mot_file_detector.h"
@@ -71,6 +72,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
   filter_options_.check();
   right_image_boxes_ = settings.people_filter.right_image == "boxes";
+  flat_box_margin_m_ = settings.people_filter.flat_box_margin_m;
   filter_before_nms_ = settings.detector.filter_before_nms;
   budget_options_.base_features = settings.orb.n_features;
   budget_options_.enabled = settings.feature_budget.enabled;
@@ -232,11 +234,26 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   out.boxes_propagated = detection_frame_ >= 0 && detection_frame_ != static_cast<int64_t>(index);
   if (detection_frame_ == static_cast<int64_t>(index)) ++stats_.frames_detected;
   if (out.boxes_propagated) ++stats_.frames_propagated;
+  const bool rgbd = sensor_ == io::SensorKind::kRgbd && !images.depth.empty();
+  if (rgbd && flat_box_margin_m_ > 0 && !area_boxes.empty()) {
+    // Boxes on a flat surface (a poster, a wall photograph): nothing stands in front of what surrounds
+    // them, so they hold no person to filter (people/box_depth.h). A raw box goes with them when its own
+    // test says flat too.
+    auto flat = [&](const people::PersonBox& b) {
+      return people::box_depth_test(images.depth, depth_map_factor_, b.box, flat_box_margin_m_).verdict ==
+             people::BoxDepthVerdict::kFlat;
+    };
+    const size_t before = area_boxes.size();
+    area_boxes.erase(std::remove_if(area_boxes.begin(), area_boxes.end(), flat), area_boxes.end());
+    out.flat_boxes = static_cast<int>(before - area_boxes.size());
+    boxes.erase(std::remove_if(boxes.begin(), boxes.end(), flat), boxes.end());
+    stats_.flat_boxes += static_cast<size_t>(out.flat_boxes);
+    if (out.flat_boxes > 0) ++stats_.frames_with_flat_boxes;
+  }
   out.person_boxes = static_cast<int>(area_boxes.size());
   out.keypoints_before_filter = static_cast<int>(raw.keys.size());
 
   std::vector<float> depth_m;
-  const bool rgbd = sensor_ == io::SensorKind::kRgbd && !images.depth.empty();
   if (filter_options_.mode == people::FilterMode::kDepth && rgbd) {
     depth_m.resize(raw.keys.size(), -1.0f);
     for (size_t i = 0; i < raw.keys.size(); ++i) {

@@ -47,6 +47,7 @@ struct PeopleFrame {
   double detector_ms = 0;       // forward time of the detection whose boxes are used (0: none new)
   double detector_wait_ms = 0;  // how long the frame waited for boxes (every_frame mode only)
   int right_keypoints_removed = 0;
+  int flat_boxes = 0;           // RGB-D: boxes with nothing standing out of their surroundings, ignored
   int64_t detection_frame = -1;  // frame the boxes were detected on (-1: no detection yet)
   bool boxes_propagated = false;  // boxes moved here from an earlier frame by the image flow
   std::vector<people::PersonBox> boxes;  // used for filtering
@@ -65,6 +66,8 @@ struct PeopleStageStats {
   std::size_t boxes_kept_in_place = 0;  // boxes the flow could not move (too few corners)
   std::size_t tracks_started = 0;
   std::size_t tracks_coasting = 0;    // summed over detections: confirmed tracks kept without a match
+  std::size_t flat_boxes = 0;         // boxes the depth test found flat (summed over frames, NMS level)
+  std::size_t frames_with_flat_boxes = 0;
 };
 
 class PeopleStage {
@@ -106,6 +109,7 @@ class PeopleStage {
   std::optional<people::BoxTracker> tracker_;
   bool filter_before_nms_ = true;
   bool right_image_boxes_ = false;
+  double flat_box_margin_m_ = 0;
   int next_feature_budget_ = 0;
   // Without the tracker, the newest detection's boxes (raw ones, with `nms_` marking those NMS kept) in
   // the frame `current_gray_` shows (latest mode).

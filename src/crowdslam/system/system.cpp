@@ -253,6 +253,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     report.detector_ms = p.detector_ms;
     report.detector_wait_ms = p.detector_wait_ms;
     report.right_keypoints_removed = p.right_keypoints_removed;
+    report.flat_boxes = p.flat_boxes;
     report.detection_frame = p.detection_frame;
     report.boxes_propagated = p.boxes_propagated;
     report.boxes = std::move(p.boxes);

@@ -88,6 +88,7 @@ struct FrameReport {
   int points_seen_through = 0;  // RGB-D: unmatched local map points the depth image sees through (free space)
   bool dynamic_check_skipped = false;  // failed with the check, tracked without it
   int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
+  int flat_boxes = 0;               // RGB-D: boxes found flat by the depth test, not filtered
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
   // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).
   int stereo_matches = 0;

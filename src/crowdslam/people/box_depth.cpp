@@ -1,0 +1,95 @@
+#include "crowdslam/people/box_depth.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace crowdslam::people {
+
+namespace {
+
+struct Patch {
+  double u = 0;
+  double v = 0;
+  double depth_m = -1.0;  // median, <= 0 when fewer than 10 valid pixels
+};
+
+// Median depth of the region [x0, x1) x [y0, y1) in box-relative units (0..1 span the box, outside is
+// allowed), clipped to the image; subsampled to about 400 pixels.
+Patch patch(const cv::Mat& depth, double factor, const cv::Rect2f& box, double x0, double y0, double x1, double y1) {
+  const cv::Rect region = cv::Rect(cv::Point(cvFloor(box.x + x0 * box.width), cvFloor(box.y + y0 * box.height)),
+                                   cv::Point(cvCeil(box.x + x1 * box.width), cvCeil(box.y + y1 * box.height))) &
+                          cv::Rect(0, 0, depth.cols, depth.rows);
+  Patch p;
+  if (region.area() <= 0) return p;
+  p.u = region.x + 0.5 * region.width;
+  p.v = region.y + 0.5 * region.height;
+  const int step = std::max(1, static_cast<int>(std::sqrt(region.area() / 400.0)));
+  std::vector<uint16_t> values;
+  for (int y = region.y; y < region.y + region.height; y += step) {
+    const auto* row = depth.ptr<uint16_t>(y);
+    for (int x = region.x; x < region.x + region.width; x += step) {
+      if (row[x] > 0) values.push_back(row[x]);
+    }
+  }
+  if (values.size() < 10) return p;
+  const auto mid = values.begin() + static_cast<long>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  p.depth_m = *mid / factor;
+  return p;
+}
+
+}  // namespace
+
+BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
+                            double margin_m) {
+  BoxDepthTest test;
+  if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1 || !(depth_factor > 0)) return test;
+  if (!(box.width > 1) || !(box.height > 1)) return test;
+  const Patch torso = patch(depth_image_raw, depth_factor, box, 0.35, 0.2, 0.65, 0.55);
+  if (torso.depth_m <= 0) return test;
+  test.torso_m = torso.depth_m;
+  // Outside patches, by side: left, right, above.
+  const Patch sides[3][3] = {
+      {patch(depth_image_raw, depth_factor, box, -0.25, 0.0, 0.0, 0.33),
+       patch(depth_image_raw, depth_factor, box, -0.25, 0.33, 0.0, 0.67),
+       patch(depth_image_raw, depth_factor, box, -0.25, 0.67, 0.0, 1.0)},
+      {patch(depth_image_raw, depth_factor, box, 1.0, 0.0, 1.25, 0.33),
+       patch(depth_image_raw, depth_factor, box, 1.0, 0.33, 1.25, 0.67),
+       patch(depth_image_raw, depth_factor, box, 1.0, 0.67, 1.25, 1.0)},
+      {patch(depth_image_raw, depth_factor, box, 0.0, -0.125, 0.5, 0.0),
+       patch(depth_image_raw, depth_factor, box, 0.5, -0.125, 1.0, 0.0), Patch{}},
+  };
+  std::vector<Patch> around;
+  int sides_seen = 0;
+  for (const auto& side : sides) {
+    bool seen = false;
+    for (const Patch& p : side) {
+      if (p.depth_m > 0) {
+        around.push_back(p);
+        seen = true;
+      }
+    }
+    sides_seen += seen ? 1 : 0;
+  }
+  if (sides_seen < 2 || around.size() < 3) return test;
+  // 1/z = a u + b v + c, least squares over the patches (pixels scaled to ~1 for conditioning).
+  const double scale = 1.0 / std::max(depth_image_raw.cols, depth_image_raw.rows);
+  Eigen::MatrixXd a(static_cast<Eigen::Index>(around.size()), 3);
+  Eigen::VectorXd b(static_cast<Eigen::Index>(around.size()));
+  for (size_t i = 0; i < around.size(); ++i) {
+    a.row(static_cast<Eigen::Index>(i)) << around[i].u * scale, around[i].v * scale, 1.0;
+    b(static_cast<Eigen::Index>(i)) = 1.0 / around[i].depth_m;
+  }
+  const Eigen::Vector3d plane = a.colPivHouseholderQr().solve(b);
+  const double inverse = plane.dot(Eigen::Vector3d(torso.u * scale, torso.v * scale, 1.0));
+  // A plane that does not reach the torso's ray in front of the camera: the surroundings are not one
+  // surface there; the torso then stands out of nothing measurable.
+  if (!(inverse > 1e-6)) return test;
+  test.surface_m = 1.0 / inverse;
+  test.verdict = test.surface_m - test.torso_m > margin_m ? BoxDepthVerdict::kStandsOut : BoxDepthVerdict::kFlat;
+  return test;
+}
+
+}  // namespace crowdslam::people

@@ -1,0 +1,109 @@
+// The depth test that tells a person box from a box on a flat surface (people/box_depth.h), on depth
+// images rendered in closed form: planes (1/z affine in the pixel) with or without a slab in front.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "crowdslam/people/box_depth.h"
+
+using namespace crowdslam::people;
+
+namespace {
+constexpr double kFactor = 5000.0;  // TUM/Bonn depth units per metre
+constexpr int kWidth = 640;
+constexpr int kHeight = 480;
+constexpr double kF = 525.0;
+constexpr double kCx = 319.5;
+constexpr double kCy = 239.5;
+
+// Depth of the plane n . X = d seen through pixel (u, v) of a pinhole camera: z = d / (n . ray).
+double plane_depth(const double n[3], double d, double u, double v) {
+  const double ray = n[0] * (u - kCx) / kF + n[1] * (v - kCy) / kF + n[2];
+  return d / ray;
+}
+
+cv::Mat plane_image(const double n[3], double d) {
+  cv::Mat depth(kHeight, kWidth, CV_16UC1);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      depth.at<uint16_t>(v, u) = static_cast<uint16_t>(std::lround(plane_depth(n, d, u, v) * kFactor));
+    }
+  }
+  return depth;
+}
+
+// A slab `closer_m` in front of the plane over the pixel rectangle `slab` (a person's body).
+void add_slab(cv::Mat& depth, const cv::Rect& slab, double closer_m) {
+  for (int v = slab.y; v < slab.y + slab.height; ++v) {
+    for (int u = slab.x; u < slab.x + slab.width; ++u) {
+      auto& z = depth.at<uint16_t>(v, u);
+      z = static_cast<uint16_t>(std::lround(z - closer_m * kFactor));
+    }
+  }
+}
+
+const double kFrontal[3] = {0.0, 0.0, 1.0};
+// A wall turned 50 degrees about the vertical axis (at 1.5 m from the camera centre): depth falls from
+// 8.5 m to 1.35 m across the image.
+const double kOblique[3] = {std::sin(50.0 * M_PI / 180.0), 0.0, std::cos(50.0 * M_PI / 180.0)};
+}  // namespace
+
+TEST(BoxDepth, ABoxOnAFrontalWallIsFlat) {
+  const cv::Mat depth = plane_image(kFrontal, 3.0);
+  const auto test = box_depth_test(depth, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2);
+  EXPECT_EQ(test.verdict, BoxDepthVerdict::kFlat);
+  EXPECT_NEAR(test.torso_m, 3.0, 1e-3);
+  EXPECT_NEAR(test.surface_m, 3.0, 1e-3);
+}
+
+TEST(BoxDepth, TheSurroundingPlanePredictsAnObliqueWallsDepthExactly) {
+  const cv::Mat depth = plane_image(kOblique, 1.5);
+  const cv::Rect2f box(300, 60, 200, 380);
+  const auto test = box_depth_test(depth, kFactor, box, 0.2);
+  EXPECT_EQ(test.verdict, BoxDepthVerdict::kFlat);
+  // The torso region's median is the plane's depth near the region's centre (the region spans depths
+  // that differ by about 0.3 m, so its median pixel is within a few centimetres of the centre's).
+  const double centre_u = box.x + 0.5 * box.width;
+  const double centre_v = box.y + 0.375 * box.height;
+  const double expected = plane_depth(kOblique, 1.5, centre_u, centre_v);
+  EXPECT_NEAR(test.surface_m, expected, 0.01 * expected);
+  EXPECT_NEAR(test.torso_m, expected, 0.02 * expected);
+}
+
+TEST(BoxDepth, APersonInFrontOfTheWallStandsOut) {
+  cv::Mat depth = plane_image(kOblique, 1.5);
+  const cv::Rect2f box(300, 60, 160, 400);
+  // The body fills the box's middle 60 % of its width and its full height, 0.4 m in front of the wall.
+  add_slab(depth, cv::Rect(332, 60, 96, 400), 0.4);
+  const auto test = box_depth_test(depth, kFactor, box, 0.2);
+  EXPECT_EQ(test.verdict, BoxDepthVerdict::kStandsOut);
+  EXPECT_NEAR(test.surface_m - test.torso_m, 0.4, 0.03);
+  // The same person with a margin larger than the gap: flat.
+  EXPECT_EQ(box_depth_test(depth, kFactor, box, 0.5).verdict, BoxDepthVerdict::kFlat);
+}
+
+TEST(BoxDepth, ABoxFillingTheImageWidthIsUndecided) {
+  cv::Mat depth = plane_image(kFrontal, 3.0);
+  // Touches the left, right and top edges: no surroundings on two sides.
+  EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 0, 640, 400), 0.2).verdict, BoxDepthVerdict::kUnknown);
+  // Only the right side and the top are seen: two sides, decided.
+  EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 50, 400, 400), 0.2).verdict, BoxDepthVerdict::kFlat);
+}
+
+TEST(BoxDepth, NoDepthIsUndecided) {
+  const cv::Mat empty;
+  EXPECT_EQ(box_depth_test(empty, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict, BoxDepthVerdict::kUnknown);
+  const cv::Mat zeros = cv::Mat::zeros(kHeight, kWidth, CV_16UC1);
+  const auto test = box_depth_test(zeros, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2);
+  EXPECT_EQ(test.verdict, BoxDepthVerdict::kUnknown);
+  EXPECT_LE(test.torso_m, 0.0);
+  // Depth on the torso but none around it (holes in the depth image): undecided.
+  cv::Mat torso_only = cv::Mat::zeros(kHeight, kWidth, CV_16UC1);
+  torso_only(cv::Rect(200, 100, 150, 300)).setTo(2 * kFactor);
+  EXPECT_EQ(box_depth_test(torso_only, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict,
+            BoxDepthVerdict::kUnknown);
+  // A float image is not a raw depth image.
+  cv::Mat wrong_type(kHeight, kWidth, CV_32FC1, cv::Scalar(2.0));
+  EXPECT_EQ(box_depth_test(wrong_type, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict,
+            BoxDepthVerdict::kUnknown);
+}
