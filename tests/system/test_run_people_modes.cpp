@@ -81,9 +81,19 @@ TEST(RunPeopleModes, TrackerModeUsesConfirmedTracksOnly) {
     if (!line.empty()) with_people.insert(std::stoi(line) - 1);
   }
   ASSERT_FALSE(with_people.empty());
+  // A box the RGB-D depth test finds flat (people/box_depth.h) is not used: the synthetic people walk
+  // along the walls, and one within 0.2 m of the wall behind it has nothing standing out (frames 0-6 and
+  // 43-45 here). Every other frame with people has boxes.
+  int flat_only = 0;
   for (const int index : with_people) {
-    EXPECT_GT(every.json["frames"][static_cast<size_t>(index)]["person_boxes"].get<int>(), 0) << "frame " << index;
+    const auto& f = every.json["frames"][static_cast<size_t>(index)];
+    if (f["person_boxes"].get<int>() == 0 && f["flat_boxes"].get<int>() > 0) {
+      ++flat_only;
+      continue;
+    }
+    EXPECT_GT(f["person_boxes"].get<int>(), 0) << "frame " << index;
   }
+  EXPECT_LE(flat_only, static_cast<int>(with_people.size()) / 3);
 }
 
 TEST(RunPeopleModes, BadModeValuesNameTheOption) {

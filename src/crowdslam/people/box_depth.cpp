@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace crowdslam::people {
@@ -61,33 +62,50 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
       {patch(depth_image_raw, depth_factor, box, 0.0, -0.125, 0.5, 0.0),
        patch(depth_image_raw, depth_factor, box, 0.5, -0.125, 1.0, 0.0), Patch{}},
   };
-  std::vector<Patch> around;
-  int sides_seen = 0;
-  for (const auto& side : sides) {
-    bool seen = false;
-    for (const Patch& p : side) {
-      if (p.depth_m > 0) {
-        around.push_back(p);
-        seen = true;
-      }
-    }
-    sides_seen += seen ? 1 : 0;
-  }
-  if (sides_seen < 2 || around.size() < 3) return test;
-  // 1/z = a u + b v + c, least squares over the patches (pixels scaled to ~1 for conditioning).
+  // Planes through the patches of every pair of sides (and all three): a box is flat only when each of
+  // them says so. A wall continuing past the box agrees on every side; a person beside a crate or another
+  // person (one side as close as they are) still stands out against the other sides.
   const double scale = 1.0 / std::max(depth_image_raw.cols, depth_image_raw.rows);
-  Eigen::MatrixXd a(static_cast<Eigen::Index>(around.size()), 3);
-  Eigen::VectorXd b(static_cast<Eigen::Index>(around.size()));
-  for (size_t i = 0; i < around.size(); ++i) {
-    a.row(static_cast<Eigen::Index>(i)) << around[i].u * scale, around[i].v * scale, 1.0;
-    b(static_cast<Eigen::Index>(i)) = 1.0 / around[i].depth_m;
+  auto gap_from = [&](const std::vector<const Patch*>& around) -> std::optional<double> {
+    if (around.size() < 3) return std::nullopt;
+    // 1/z = a u + b v + c, least squares over the patches (pixels scaled to ~1 for conditioning).
+    Eigen::MatrixXd a(static_cast<Eigen::Index>(around.size()), 3);
+    Eigen::VectorXd b(static_cast<Eigen::Index>(around.size()));
+    for (size_t i = 0; i < around.size(); ++i) {
+      a.row(static_cast<Eigen::Index>(i)) << around[i]->u * scale, around[i]->v * scale, 1.0;
+      b(static_cast<Eigen::Index>(i)) = 1.0 / around[i]->depth_m;
+    }
+    const Eigen::Vector3d plane = a.colPivHouseholderQr().solve(b);
+    const double inverse = plane.dot(Eigen::Vector3d(torso.u * scale, torso.v * scale, 1.0));
+    // A plane that does not reach the torso's ray in front of the camera: the surroundings are not one
+    // surface there, nothing to compare with.
+    if (!(inverse > 1e-6)) return std::nullopt;
+    return 1.0 / inverse;
+  };
+  std::vector<const Patch*> by_side[3];
+  for (int s = 0; s < 3; ++s) {
+    for (const Patch& p : sides[s]) {
+      if (p.depth_m > 0) by_side[s].push_back(&p);
+    }
   }
-  const Eigen::Vector3d plane = a.colPivHouseholderQr().solve(b);
-  const double inverse = plane.dot(Eigen::Vector3d(torso.u * scale, torso.v * scale, 1.0));
-  // A plane that does not reach the torso's ray in front of the camera: the surroundings are not one
-  // surface there; the torso then stands out of nothing measurable.
-  if (!(inverse > 1e-6)) return test;
-  test.surface_m = 1.0 / inverse;
+  const int combinations[4][3] = {{0, 1, 2}, {0, 1, -1}, {0, 2, -1}, {1, 2, -1}};
+  bool decided = false;
+  for (const auto& combination : combinations) {
+    std::vector<const Patch*> around;
+    int sides_used = 0;
+    for (const int s : combination) {
+      if (s < 0 || by_side[s].empty()) continue;
+      around.insert(around.end(), by_side[s].begin(), by_side[s].end());
+      ++sides_used;
+    }
+    if (sides_used < 2) continue;
+    const auto surface = gap_from(around);
+    if (!surface) continue;
+    // Reported: the surface the torso stands out of most.
+    if (!decided || *surface > test.surface_m) test.surface_m = *surface;
+    decided = true;
+  }
+  if (!decided) return test;
   test.verdict = test.surface_m - test.torso_m > margin_m ? BoxDepthVerdict::kStandsOut : BoxDepthVerdict::kFlat;
   return test;
 }

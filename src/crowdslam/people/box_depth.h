@@ -4,10 +4,12 @@
 // A person is a solid object in front of what is around them; a detector firing on a poster, a wall
 // photograph or a screen boxes a surface that continues past the box. With a depth image that is
 // measurable: the depth of the box's torso region (35-65 % of its width, 20-55 % of its height, median)
-// against a plane fitted in inverse depth (exact for a planar surface: 1/z is affine in the pixel) to the
+// against planes fitted in inverse depth (exact for a planar surface: 1/z is affine in the pixel) to the
 // median depths of patches just outside the box (a quarter of the box's width to its left and right, at
-// three heights; an eighth of its height above it, two halves). If the torso is not closer than that
-// plane by more than `margin_m`, the box is flat: nothing stands out of the surface it was found on.
+// three heights; an eighth of its height above it, two halves): one plane through each pair of sides and
+// one through all three. If the torso is not closer than any of these planes by more than `margin_m`, the
+// box is flat: nothing stands out of the surface it was found on. (A person beside a crate or another
+// person, one side as close as they are, still stands out against the pair of the other sides.)
 // Undecidable (kUnknown) without depth, or with patches on fewer than two sides of the box (a box that
 // fills the image's width); those boxes are kept as they are.
 #include <opencv2/core.hpp>
@@ -19,7 +21,7 @@ enum class BoxDepthVerdict { kStandsOut, kFlat, kUnknown };
 struct BoxDepthTest {
   BoxDepthVerdict verdict = BoxDepthVerdict::kUnknown;
   double torso_m = -1.0;    // median depth of the torso region (<= 0: none)
-  double surface_m = -1.0;  // depth the surrounding plane predicts there (<= 0: none)
+  double surface_m = -1.0;  // the deepest surface the planes predict there (<= 0: none)
 };
 
 // depth_image_raw: CV_16UC1, metres = value / depth_factor, 0 = no measurement.

@@ -48,9 +48,39 @@ void seed_points(const cv::Mat& gray, std::vector<FlowBox>& boxes, const BoxFlow
   }
 }
 
+FlowImage make_flow_image(const cv::Mat& gray, const BoxFlowOptions& options) {
+  CV_Assert(gray.type() == CV_8UC1);
+  FlowImage image;
+  image.gray = gray;
+  cv::buildOpticalFlowPyramid(gray, image.pyramid, cv::Size(options.window, options.window), options.levels);
+  return image;
+}
+
+cv::Rect2f follow_motion(const cv::Rect2f& box, const cv::Point2f& leader_centre, const BoxMotion& motion,
+                         int width, int height) {
+  if (motion.left_image) return {};
+  if (!motion.moved) return box;
+  const double cx = leader_centre.x + motion.dx + motion.scale * (box.x + 0.5 * box.width - leader_centre.x);
+  const double cy = leader_centre.y + motion.dy + motion.scale * (box.y + 0.5 * box.height - leader_centre.y);
+  const double w = box.width * motion.scale;
+  const double h = box.height * motion.scale;
+  return clip_box(cv::Rect2f(static_cast<float>(cx - 0.5 * w), static_cast<float>(cy - 0.5 * h),
+                             static_cast<float>(w), static_cast<float>(h)),
+                  width, height);
+}
+
 FlowStats move_boxes(const cv::Mat& from, const cv::Mat& to, std::vector<FlowBox>& boxes,
                      const BoxFlowOptions& options) {
   CV_Assert(from.type() == CV_8UC1 && to.type() == CV_8UC1 && from.size() == to.size());
+  return move_boxes(make_flow_image(from, options), make_flow_image(to, options), boxes, options);
+}
+
+FlowStats move_boxes(const FlowImage& from_image, const FlowImage& to_image, std::vector<FlowBox>& boxes,
+                     const BoxFlowOptions& options, std::vector<BoxMotion>* motions) {
+  const cv::Mat& from = from_image.gray;
+  const cv::Mat& to = to_image.gray;
+  CV_Assert(from.type() == CV_8UC1 && to.type() == CV_8UC1 && from.size() == to.size());
+  if (motions != nullptr) motions->assign(boxes.size(), BoxMotion{});
   FlowStats stats;
   std::vector<cv::Point2f> start;
   for (const FlowBox& b : boxes) start.insert(start.end(), b.points.begin(), b.points.end());
@@ -60,15 +90,18 @@ FlowStats move_boxes(const cv::Mat& from, const cv::Mat& to, std::vector<FlowBox
   if (!start.empty()) {
     const cv::Size window(options.window, options.window);
     const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
-    cv::calcOpticalFlowPyrLK(from, to, start, forward, ok_forward, error, window, options.levels, stop);
-    cv::calcOpticalFlowPyrLK(to, from, forward, backward, ok_backward, error, window, options.levels, stop);
+    cv::calcOpticalFlowPyrLK(from_image.pyramid, to_image.pyramid, start, forward, ok_forward, error, window,
+                             options.levels, stop);
+    cv::calcOpticalFlowPyrLK(to_image.pyramid, from_image.pyramid, forward, backward, ok_backward, error, window,
+                             options.levels, stop);
   }
   const float width = static_cast<float>(to.cols);
   const float height = static_cast<float>(to.rows);
   std::vector<FlowBox> moved;
   moved.reserve(boxes.size());
   std::size_t offset = 0;
-  for (FlowBox& b : boxes) {
+  for (std::size_t index = 0; index < boxes.size(); ++index) {
+    FlowBox& b = boxes[index];
     std::vector<cv::Point2f> before, after;
     for (std::size_t i = offset; i < offset + b.points.size(); ++i) {
       if (!ok_forward[i] || !ok_backward[i]) continue;
@@ -109,7 +142,11 @@ FlowStats move_boxes(const cv::Mat& from, const cv::Mat& to, std::vector<FlowBox
     b.box.box = clip_box(cv::Rect2f(static_cast<float>(cx - 0.5 * w), static_cast<float>(cy - 0.5 * h),
                                     static_cast<float>(w), static_cast<float>(h)),
                          to.cols, to.rows);
-    if (!(b.box.box.width > 0) || !(b.box.box.height > 0)) continue;  // left the image
+    if (motions != nullptr) (*motions)[index] = BoxMotion{true, false, tx, ty, scale};
+    if (!(b.box.box.width > 0) || !(b.box.box.height > 0)) {  // left the image
+      if (motions != nullptr) (*motions)[index] = BoxMotion{false, true, tx, ty, scale};
+      continue;
+    }
     b.points.clear();
     for (const auto& p : after) {
       if (p.x >= 0 && p.y >= 0 && p.x < width && p.y < height) b.points.push_back(p);

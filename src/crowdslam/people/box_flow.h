@@ -32,6 +32,29 @@ struct BoxFlowOptions {
   void check() const;            // throws InputError naming the bad value
 };
 
+// A grey frame with its LK pyramid, built once and reused by every move from or to that frame.
+struct FlowImage {
+  cv::Mat gray;
+  std::vector<cv::Mat> pyramid;
+  [[nodiscard]] bool empty() const { return gray.empty(); }
+};
+FlowImage make_flow_image(const cv::Mat& gray, const BoxFlowOptions& options);
+
+// How one box moved: its centre by (dx, dy), its size by `scale` about its centre.
+struct BoxMotion {
+  bool moved = false;     // false: kept in place (too few corners) or left the image
+  bool left_image = false;
+  double dx = 0;
+  double dy = 0;
+  double scale = 1.0;
+};
+
+// The same motion applied to another box (a raw box that follows the NMS box that suppressed it):
+// translated by (dx, dy) and scaled by `scale` about the leader's centre `leader_centre` (before the
+// move), clipped to the image. Returns an empty box when it left the image.
+cv::Rect2f follow_motion(const cv::Rect2f& box, const cv::Point2f& leader_centre, const BoxMotion& motion,
+                         int width, int height);
+
 struct FlowStats {
   std::size_t boxes_moved = 0;   // boxes moved by their corners' flow
   std::size_t boxes_kept = 0;    // boxes left in place (too few corners survived)
@@ -44,6 +67,9 @@ void seed_points(const cv::Mat& gray, std::vector<FlowBox>& boxes, const BoxFlow
 // image; a box that leaves it entirely is removed. Points are updated to their positions in `to`.
 FlowStats move_boxes(const cv::Mat& from, const cv::Mat& to, std::vector<FlowBox>& boxes,
                      const BoxFlowOptions& options);
+// The same with prebuilt pyramids; `motions` (optional) gets one entry per input box, in input order.
+FlowStats move_boxes(const FlowImage& from, const FlowImage& to, std::vector<FlowBox>& boxes,
+                     const BoxFlowOptions& options, std::vector<BoxMotion>* motions = nullptr);
 
 std::vector<FlowBox> to_flow_boxes(const std::vector<PersonBox>& boxes);
 std::vector<PersonBox> to_person_boxes(const std::vector<FlowBox>& boxes);

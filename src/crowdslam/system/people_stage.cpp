@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "crowdslam/people/box_depth.h"
 #include "crowdslam/people/detector_setup.h"
@@ -14,6 +15,7 @@
 
 namespace crowdslam::system {
 namespace {
+constexpr double kFlatTestMinArea = 0.1;  // fraction of the image (see PeopleStage::filter)
 
 constexpr double kSparseDepthFactor = 1000.0;  // millimetres in the stereo sparse depth image
 
@@ -85,10 +87,14 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
 
 namespace {
 // Reseeds the corners of boxes that have few left (lost to occlusion and the forward-backward check).
-void reseed_thin(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const people::BoxFlowOptions& options) {
+// Reseeds the corners of tracked boxes (no leader) that have few left (lost to occlusion and the
+// forward-backward check).
+void reseed_thin(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const std::vector<int>* leader,
+                 const people::BoxFlowOptions& options) {
   std::vector<size_t> thin;
   std::vector<people::FlowBox> reseed;
   for (size_t i = 0; i < boxes.size(); ++i) {
+    if (leader != nullptr && (*leader)[i] >= 0) continue;
     if (static_cast<int>(boxes[i].points.size()) < 2 * options.min_points) {
       thin.push_back(i);
       reseed.push_back(boxes[i]);
@@ -98,45 +104,119 @@ void reseed_thin(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const
   people::seed_points(gray, reseed, options);
   for (size_t k = 0; k < thin.size(); ++k) boxes[thin[k]].points = std::move(reseed[k].points);
 }
-}  // namespace
 
-// Moves `boxes` from `from` to `to`; `nms` (one flag per box, may be empty) follows its boxes.
-void PeopleStage::flow(const cv::Mat& from, const cv::Mat& to, std::vector<people::FlowBox>& boxes,
-                       std::vector<bool>* nms) {
-  std::vector<int> ids;
-  ids.reserve(boxes.size());
-  for (const auto& b : boxes) ids.push_back(b.track_id);
-  for (size_t i = 0; i < boxes.size(); ++i) boxes[i].track_id = static_cast<int>(i);
-  const people::FlowStats s = people::move_boxes(from, to, boxes, flow_options_);
-  stats_.boxes_moved += s.boxes_moved;
-  stats_.boxes_kept_in_place += s.boxes_kept;
-  std::vector<bool> flags;
-  for (auto& b : boxes) {
-    const size_t original = static_cast<size_t>(b.track_id);
-    if (nms != nullptr && !nms->empty()) flags.push_back((*nms)[original]);
-    b.track_id = ids[original];
+// Seeds corners in the boxes without a leader (all boxes when `leader` is null).
+void seed_leaders(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const std::vector<int>* leader,
+                  const people::BoxFlowOptions& options) {
+  std::vector<size_t> index;
+  std::vector<people::FlowBox> seeded;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (leader != nullptr && (*leader)[i] >= 0) continue;
+    index.push_back(i);
+    seeded.push_back(boxes[i]);
   }
-  if (nms != nullptr) *nms = std::move(flags);
+  people::seed_points(gray, seeded, options);
+  for (size_t k = 0; k < index.size(); ++k) boxes[index[k]].points = std::move(seeded[k].points);
 }
 
-void PeopleStage::move_to(const cv::Mat& gray) {
-  if (!current_gray_.empty() && current_gray_.size() == gray.size() && current_gray_.data != gray.data) {
+// For raw boxes: the NMS box each one follows (the kept box it overlaps most), -1 for the kept boxes
+// themselves and for a raw box that overlaps none.
+std::vector<int> leaders_of(const std::vector<people::FlowBox>& boxes, const std::vector<bool>& nms) {
+  std::vector<int> leader(boxes.size(), -1);
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (nms[i]) continue;
+    double best = 0;
+    for (size_t k = 0; k < boxes.size(); ++k) {
+      if (!nms[k]) continue;
+      const cv::Rect2f& a = boxes[i].box.box;
+      const cv::Rect2f& b = boxes[k].box.box;
+      const double overlap = (a & b).area();
+      const double iou = overlap > 0 ? overlap / (a.area() + b.area() - overlap) : 0.0;
+      if (iou > best) {
+        best = iou;
+        leader[i] = static_cast<int>(k);
+      }
+    }
+  }
+  return leader;
+}
+}  // namespace
+
+// Moves `boxes` from `from` to `to`: boxes without a leader by the flow of their corners, the others
+// (raw boxes) by their leader's motion. `nms` and `leader` (one entry per box, may be null) follow their
+// boxes; a box that leaves the image is removed.
+void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& to, std::vector<people::FlowBox>& boxes,
+                       std::vector<bool>* nms, std::vector<int>* leader) {
+  const auto has_leader = [&](size_t i) { return leader != nullptr && (*leader)[i] >= 0; };
+  std::vector<people::FlowBox> tracked;
+  std::vector<cv::Point2f> centre(boxes.size());
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    const cv::Rect2f& r = boxes[i].box.box;
+    centre[i] = cv::Point2f(r.x + 0.5f * r.width, r.y + 0.5f * r.height);
+    if (has_leader(i)) continue;
+    tracked.push_back(boxes[i]);
+    tracked.back().track_id = static_cast<int>(i);  // the original index, restored below
+  }
+  std::vector<people::BoxMotion> tracked_motion;
+  const people::FlowStats s = people::move_boxes(from, to, tracked, flow_options_, &tracked_motion);
+  stats_.boxes_moved += s.boxes_moved;
+  stats_.boxes_kept_in_place += s.boxes_kept;
+  std::vector<people::BoxMotion> motion(boxes.size());
+  for (size_t i = 0, k = 0; i < boxes.size(); ++i) {
+    if (!has_leader(i)) motion[i] = tracked_motion[k++];
+  }
+  std::vector<std::optional<people::FlowBox>> moved(boxes.size());
+  for (auto& b : tracked) {
+    const auto original = static_cast<size_t>(b.track_id);
+    b.track_id = boxes[original].track_id;
+    moved[original] = std::move(b);
+  }
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (!has_leader(i)) continue;
+    const auto l = static_cast<size_t>((*leader)[i]);
+    const cv::Rect2f r = people::follow_motion(boxes[i].box.box, centre[l], motion[l], to.gray.cols, to.gray.rows);
+    if (!(r.width > 0) || !(r.height > 0)) continue;
+    moved[i] = boxes[i];
+    moved[i]->box.box = r;
+    if (motion[l].moved) ++stats_.boxes_moved;
+  }
+  std::vector<int> new_index(boxes.size(), -1);
+  std::vector<people::FlowBox> out;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (!moved[i]) continue;
+    new_index[i] = static_cast<int>(out.size());
+    out.push_back(std::move(*moved[i]));
+  }
+  std::vector<bool> flags;
+  std::vector<int> leaders;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (new_index[i] < 0) continue;
+    if (nms != nullptr && !nms->empty()) flags.push_back((*nms)[i]);
+    if (leader != nullptr) leaders.push_back(has_leader(i) ? new_index[static_cast<size_t>((*leader)[i])] : -1);
+  }
+  boxes = std::move(out);
+  if (nms != nullptr) *nms = std::move(flags);
+  if (leader != nullptr) *leader = std::move(leaders);
+}
+
+void PeopleStage::move_to(const people::FlowImage& image) {
+  if (!current_.empty() && current_.gray.size() == image.gray.size() && current_.gray.data != image.gray.data) {
     if (tracker_) {
       std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
       if (!boxes.empty()) {
-        flow(current_gray_, gray, boxes, nullptr);
-        reseed_thin(gray, boxes, flow_options_);
+        flow(current_, image, boxes, nullptr, nullptr);
+        reseed_thin(image.gray, boxes, nullptr, flow_options_);
         tracker_->apply_moved(boxes);
       }
     } else if (!boxes_.empty()) {
-      flow(current_gray_, gray, boxes_, &nms_);
-      reseed_thin(gray, boxes_, flow_options_);
+      flow(current_, image, boxes_, &nms_, &leader_);
+      reseed_thin(image.gray, boxes_, &leader_, flow_options_);
     }
   }
-  current_gray_ = gray;
+  current_ = image;
 }
 
-void PeopleStage::take_detection(people::WorkerResult result, const cv::Mat& gray) {
+void PeopleStage::take_detection(people::WorkerResult result, const people::FlowImage& image) {
   ++stats_.detections;
   fresh_ = true;
   detection_frame_ = static_cast<int64_t>(result.frame_index);
@@ -152,12 +232,14 @@ void PeopleStage::take_detection(people::WorkerResult result, const cv::Mat& gra
                            [&](const people::PersonBox& b) { return b.box == box; });
     }
   }
+  // Raw boxes move with the NMS box they overlap most: the flow is computed for the few NMS boxes only.
+  std::vector<int> leader = leaders_of(detected, nms);
   // Latest mode: the detection was made on an earlier frame; move it from that frame's image to this one.
-  const bool older = mode_ == DetectorMode::kLatest && !offered_gray_.empty() &&
-                     offered_gray_.size() == gray.size() && offered_gray_.data != gray.data;
+  const bool older = mode_ == DetectorMode::kLatest && !offered_.empty() &&
+                     offered_.gray.size() == image.gray.size() && offered_.gray.data != image.gray.data;
   if (older) {
-    people::seed_points(offered_gray_, detected, flow_options_);
-    flow(offered_gray_, gray, detected, &nms);
+    seed_leaders(offered_.gray, detected, &leader, flow_options_);
+    flow(offered_, image, detected, &nms, &leader);
   }
   if (tracker_) {
     const people::TrackerUpdate u = tracker_->update(people::to_person_boxes(detected));
@@ -166,13 +248,16 @@ void PeopleStage::take_detection(people::WorkerResult result, const cv::Mat& gra
     std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
     std::vector<people::FlowBox> refreshed;
     for (size_t i : tracker_->refreshed()) refreshed.push_back(boxes[i]);
-    people::seed_points(gray, refreshed, flow_options_);
+    people::seed_points(image.gray, refreshed, flow_options_);
     for (size_t k = 0; k < refreshed.size(); ++k) boxes[tracker_->refreshed()[k]].points = refreshed[k].points;
     tracker_->apply_moved(boxes);
   } else {
-    if (mode_ == DetectorMode::kLatest) people::seed_points(gray, detected, flow_options_);
+    // The moved boxes keep the corners that followed them; boxes left with few (or none, when the
+    // detection is this frame's own) get new ones here.
+    if (mode_ == DetectorMode::kLatest) reseed_thin(image.gray, detected, &leader, flow_options_);
     boxes_ = std::move(detected);
     nms_ = std::move(nms);
+    leader_ = std::move(leader);
   }
 }
 
@@ -181,13 +266,14 @@ void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv
   detection_ms_ = 0;
   if (mode_ == DetectorMode::kEveryFrame) {
     worker_->submit(index, colour);
-    if (tracker_) move_to(gray);  // coasting tracks follow the image
+    if (tracker_) move_to(people::make_flow_image(gray, flow_options_));  // coasting tracks follow the image
     return;
   }
-  move_to(gray);
-  if (auto result = worker_->poll()) take_detection(std::move(*result), gray);
+  const people::FlowImage image = people::make_flow_image(gray, flow_options_);
+  move_to(image);
+  if (auto result = worker_->poll()) take_detection(std::move(*result), image);
   if (worker_->offer(index, colour)) {
-    offered_gray_ = gray;
+    offered_ = image;
     offered_index_ = index;
   }
 }
@@ -215,7 +301,7 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     people::WorkerResult result = worker_->wait(index);
     out.detector_wait_ms = result.waited_ms;
     if (tracker_) {
-      take_detection(std::move(result), current_gray_);
+      take_detection(std::move(result), current_);
       current_boxes(boxes, area_boxes);
     } else {
       // The paper's path, unchanged: this frame's own boxes.
@@ -235,24 +321,6 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   if (detection_frame_ == static_cast<int64_t>(index)) ++stats_.frames_detected;
   if (out.boxes_propagated) ++stats_.frames_propagated;
   const bool rgbd = sensor_ == io::SensorKind::kRgbd && !images.depth.empty();
-  if (rgbd && flat_box_margin_m_ > 0 && !area_boxes.empty()) {
-    // Boxes on a flat surface (a poster, a wall photograph): nothing stands in front of what surrounds
-    // them, so they hold no person to filter (people/box_depth.h). A raw box goes with them when its own
-    // test says flat too.
-    auto flat = [&](const people::PersonBox& b) {
-      return people::box_depth_test(images.depth, depth_map_factor_, b.box, flat_box_margin_m_).verdict ==
-             people::BoxDepthVerdict::kFlat;
-    };
-    const size_t before = area_boxes.size();
-    area_boxes.erase(std::remove_if(area_boxes.begin(), area_boxes.end(), flat), area_boxes.end());
-    out.flat_boxes = static_cast<int>(before - area_boxes.size());
-    boxes.erase(std::remove_if(boxes.begin(), boxes.end(), flat), boxes.end());
-    stats_.flat_boxes += static_cast<size_t>(out.flat_boxes);
-    if (out.flat_boxes > 0) ++stats_.frames_with_flat_boxes;
-  }
-  out.person_boxes = static_cast<int>(area_boxes.size());
-  out.keypoints_before_filter = static_cast<int>(raw.keys.size());
-
   std::vector<float> depth_m;
   if (filter_options_.mode == people::FilterMode::kDepth && rgbd) {
     depth_m.resize(raw.keys.size(), -1.0f);
@@ -265,16 +333,38 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     }
   }
   // Stereo: the keypoints' depths come from stereo matching, which runs before the filter; each person's
-  // depth is estimated from them through a sparse depth image.
+  // depth (and the flat-box test) works on them through a sparse depth image.
   cv::Mat stereo_depth;
   const bool stereo = sensor_ == io::SensorKind::kStereo && raw.depth_m.size() == raw.keys.size();
-  if (filter_options_.mode == people::FilterMode::kDepth && stereo && !boxes.empty()) {
-    depth_m = raw.depth_m;
+  const bool depth_mode = filter_options_.mode == people::FilterMode::kDepth;
+  if (stereo && !boxes.empty() && (depth_mode || flat_box_margin_m_ > 0)) {
+    if (depth_mode) depth_m = raw.depth_m;
     stereo_depth = sparse_depth_image(raw.keys, raw.depth_m, images.colour.size(), kSparseDepthFactor);
   }
   const double depth_factor = stereo ? kSparseDepthFactor : depth_map_factor_;
+  const cv::Mat& depth_image = rgbd ? images.depth : stereo_depth;
+  if (!depth_image.empty() && flat_box_margin_m_ > 0 && !area_boxes.empty()) {
+    // Boxes on a flat surface (a poster, a wall photograph): nothing stands in front of what surrounds
+    // them, so they hold no person to filter (people/box_depth.h). Each raw box is tested on its own.
+    // Boxes under a tenth of the image are left alone: they cost tracking little, and that is where the
+    // test misjudges people (partly in view at the image's edge, or far away among others).
+    const double min_area = kFlatTestMinArea * depth_image.cols * depth_image.rows;
+    auto flat = [&](const people::PersonBox& b) {
+      return b.box.area() >= min_area &&
+             people::box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict ==
+                 people::BoxDepthVerdict::kFlat;
+    };
+    const size_t before = area_boxes.size();
+    area_boxes.erase(std::remove_if(area_boxes.begin(), area_boxes.end(), flat), area_boxes.end());
+    out.flat_boxes = static_cast<int>(before - area_boxes.size());
+    boxes.erase(std::remove_if(boxes.begin(), boxes.end(), flat), boxes.end());
+    stats_.flat_boxes += static_cast<size_t>(out.flat_boxes);
+    if (out.flat_boxes > 0) ++stats_.frames_with_flat_boxes;
+  }
+  out.person_boxes = static_cast<int>(area_boxes.size());
+  out.keypoints_before_filter = static_cast<int>(raw.keys.size());
   const people::FilterResult filtered = people::filter_keypoints(
-      raw.keys, boxes, filter_options_, depth_m, rgbd ? images.depth : stereo_depth, depth_factor);
+      raw.keys, boxes, filter_options_, depth_m, depth_image, depth_factor);
   if (filtered.removed > 0) {
     tracking::RawFeatures kept;
     kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));

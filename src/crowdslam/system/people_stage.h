@@ -92,11 +92,12 @@ class PeopleStage {
 
  private:
   // A detection result in the current frame's coordinates: moved from its own frame's grey image.
-  void take_detection(people::WorkerResult result, const cv::Mat& gray);
+  void take_detection(people::WorkerResult result, const people::FlowImage& image);
   // Boxes the filter uses now, and the ones (NMS level) that say how much of the image people cover.
   void current_boxes(std::vector<people::PersonBox>& filter_boxes, std::vector<people::PersonBox>& area_boxes) const;
-  void move_to(const cv::Mat& gray);
-  void flow(const cv::Mat& from, const cv::Mat& to, std::vector<people::FlowBox>& boxes, std::vector<bool>* nms);
+  void move_to(const people::FlowImage& image);
+  void flow(const people::FlowImage& from, const people::FlowImage& to, std::vector<people::FlowBox>& boxes,
+            std::vector<bool>* nms, std::vector<int>* leader);
 
   io::SensorKind sensor_;
   double depth_map_factor_ = 1.0;
@@ -112,11 +113,12 @@ class PeopleStage {
   double flat_box_margin_m_ = 0;
   int next_feature_budget_ = 0;
   // Without the tracker, the newest detection's boxes (raw ones, with `nms_` marking those NMS kept) in
-  // the frame `current_gray_` shows (latest mode).
+  // the frame `current_` shows (latest mode).
   std::vector<people::FlowBox> boxes_;
   std::vector<bool> nms_;
-  cv::Mat current_gray_;
-  cv::Mat offered_gray_;           // the frame the detector is working on (latest mode)
+  std::vector<int> leader_;        // per box: the NMS box a raw box moves with (-1: moved by its own flow)
+  people::FlowImage current_;
+  people::FlowImage offered_;      // the frame the detector is working on (latest mode)
   std::size_t offered_index_ = 0;
   int64_t detection_frame_ = -1;
   double detection_ms_ = 0;        // forward time of the detection taken this frame
