@@ -108,5 +108,48 @@ TEST(BoxFlow, OptionsAreChecked) {
   EXPECT_THROW(options.check(), InputError);
 }
 
+TEST(BoxFlow, ReportsEachBoxsMotionWithPrebuiltPyramids) {
+  const cv::Mat patch = textured(cv::Size(80, 160), 7);
+  const cv::Mat f0 = frame_with_patch(patch, cv::Rect(200, 150, 80, 160));
+  const cv::Mat f1 = frame_with_patch(patch, cv::Rect(207, 146, 80, 160));  // shifted by (+7, -4)
+  BoxFlowOptions options;
+  // The person's box, and a box on the flat background that cannot be tracked.
+  std::vector<FlowBox> boxes{FlowBox{PersonBox{cv::Rect2f(200, 150, 80, 160), 0.9f}, {}, -1},
+                             FlowBox{PersonBox{cv::Rect2f(450, 50, 80, 100), 0.4f}, {}, -1}};
+  seed_points(f0, boxes, options);
+  std::vector<BoxMotion> motions;
+  const FlowStats stats = move_boxes(make_flow_image(f0, options), make_flow_image(f1, options), boxes, options, &motions);
+  EXPECT_EQ(stats.boxes_moved, 1u);
+  EXPECT_EQ(stats.boxes_kept, 1u);
+  ASSERT_EQ(motions.size(), 2u);
+  EXPECT_TRUE(motions[0].moved);
+  EXPECT_NEAR(motions[0].dx, 7.0, 0.3);
+  EXPECT_NEAR(motions[0].dy, -4.0, 0.3);
+  EXPECT_NEAR(motions[0].scale, 1.0, 0.02);
+  EXPECT_FALSE(motions[1].moved);
+  EXPECT_FALSE(motions[1].left_image);
+}
+
+TEST(BoxFlow, AFollowerTakesItsLeadersMotionAboutTheLeadersCentre) {
+  const cv::Point2f leader_centre(100, 100);
+  const BoxMotion motion{true, false, 5.0, -3.0, 1.1};
+  // Centre (100, 120): 20 px below the leader's centre, so 22 px below it after the 1.1 scale.
+  const cv::Rect2f moved = follow_motion(cv::Rect2f(80, 90, 40, 60), leader_centre, motion, 640, 480);
+  EXPECT_NEAR(moved.x + 0.5 * moved.width, 105.0, 1e-4);
+  EXPECT_NEAR(moved.y + 0.5 * moved.height, 119.0, 1e-4);
+  EXPECT_NEAR(moved.width, 44.0, 1e-4);
+  EXPECT_NEAR(moved.height, 66.0, 1e-4);
+  // A leader left in place leaves its followers in place; one that left the image takes them along.
+  const cv::Rect2f kept = follow_motion(cv::Rect2f(80, 90, 40, 60), leader_centre, BoxMotion{}, 640, 480);
+  EXPECT_EQ(kept, cv::Rect2f(80, 90, 40, 60));
+  const cv::Rect2f gone =
+      follow_motion(cv::Rect2f(80, 90, 40, 60), leader_centre, BoxMotion{false, true, 0, 0, 1}, 640, 480);
+  EXPECT_FALSE(gone.width > 0 && gone.height > 0);
+  // Clipped to the image.
+  const cv::Rect2f clipped =
+      follow_motion(cv::Rect2f(600, 90, 40, 60), cv::Point2f(620, 120), BoxMotion{true, false, 30, 0, 1}, 640, 480);
+  EXPECT_NEAR(clipped.x + clipped.width, 640.0, 1e-4);
+}
+
 }  // namespace
 }  // namespace crowdslam::people
