@@ -118,7 +118,8 @@ TEST(BoxFlow, ReportsEachBoxsMotionWithPrebuiltPyramids) {
                              FlowBox{PersonBox{cv::Rect2f(450, 50, 80, 100), 0.4f}, {}, -1}};
   seed_points(f0, boxes, options);
   std::vector<BoxMotion> motions;
-  const FlowStats stats = move_boxes(make_flow_image(f0, options), make_flow_image(f1, options), boxes, options, &motions);
+  const FlowStats stats =
+      move_boxes(make_flow_image(f0, options), make_flow_image(f1, options), boxes, options, &motions);
   EXPECT_EQ(stats.boxes_moved, 1u);
   EXPECT_EQ(stats.boxes_kept, 1u);
   ASSERT_EQ(motions.size(), 2u);

@@ -83,8 +83,8 @@ TEST(RunPeopleModes, TrackerModeUsesConfirmedTracksOnly) {
   ASSERT_FALSE(with_people.empty());
   // A box the RGB-D depth test finds flat (people/box_depth.h) is not used: the synthetic people walk
   // along the walls and furniture, and one within 0.2 m of everything around it has nothing standing out
-  // (one frame here, 44: a person close to the camera, their box cut by the image top). Every other frame with
-  // people has boxes.
+  // (one frame here, 44: a person close to the camera, their box cut by the image top). Every other
+  // frame with people has boxes.
   int flat_only = 0;
   for (const int index : with_people) {
     const auto& f = every.json["frames"][static_cast<size_t>(index)];
