@@ -85,14 +85,16 @@ TEST(BoxDepth, APersonInFrontOfTheWallStandsOut) {
 TEST(BoxDepth, ABoxFillingTheImageWidthIsUndecided) {
   cv::Mat depth = plane_image(kFrontal, 3.0);
   // Touches the left, right and top edges: no surroundings on two sides.
-  EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 0, 640, 400), 0.2).verdict, BoxDepthVerdict::kUnknown);
+  EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 0, 640, 400), 0.2).verdict,
+            BoxDepthVerdict::kUnknown);
   // Only the right side and the top are seen: two sides, decided.
   EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 50, 400, 400), 0.2).verdict, BoxDepthVerdict::kFlat);
 }
 
 TEST(BoxDepth, NoDepthIsUndecided) {
   const cv::Mat empty;
-  EXPECT_EQ(box_depth_test(empty, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict, BoxDepthVerdict::kUnknown);
+  EXPECT_EQ(box_depth_test(empty, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict,
+            BoxDepthVerdict::kUnknown);
   const cv::Mat zeros = cv::Mat::zeros(kHeight, kWidth, CV_16UC1);
   const auto test = box_depth_test(zeros, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2);
   EXPECT_EQ(test.verdict, BoxDepthVerdict::kUnknown);

@@ -18,10 +18,12 @@ struct Patch {
 
 // Median depth of the region [x0, x1) x [y0, y1) in box-relative units (0..1 span the box, outside is
 // allowed), clipped to the image; subsampled to about 400 pixels.
-Patch patch(const cv::Mat& depth, double factor, const cv::Rect2f& box, double x0, double y0, double x1, double y1) {
-  const cv::Rect region = cv::Rect(cv::Point(cvFloor(box.x + x0 * box.width), cvFloor(box.y + y0 * box.height)),
-                                   cv::Point(cvCeil(box.x + x1 * box.width), cvCeil(box.y + y1 * box.height))) &
-                          cv::Rect(0, 0, depth.cols, depth.rows);
+Patch patch(const cv::Mat& depth, double factor, const cv::Rect2f& box, double x0, double y0, double x1,
+            double y1) {
+  const cv::Rect region =
+      cv::Rect(cv::Point(cvFloor(box.x + x0 * box.width), cvFloor(box.y + y0 * box.height)),
+               cv::Point(cvCeil(box.x + x1 * box.width), cvCeil(box.y + y1 * box.height))) &
+      cv::Rect(0, 0, depth.cols, depth.rows);
   Patch p;
   if (region.area() <= 0) return p;
   p.u = region.x + 0.5 * region.width;
@@ -106,7 +108,8 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
     decided = true;
   }
   if (!decided) return test;
-  test.verdict = test.surface_m - test.torso_m > margin_m ? BoxDepthVerdict::kStandsOut : BoxDepthVerdict::kFlat;
+  test.verdict =
+      test.surface_m - test.torso_m > margin_m ? BoxDepthVerdict::kStandsOut : BoxDepthVerdict::kFlat;
   return test;
 }
 
