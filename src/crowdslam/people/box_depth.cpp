@@ -28,14 +28,7 @@ Patch patch(const cv::Mat& depth, double factor, const cv::Rect2f& box, double x
   if (region.area() <= 0) return p;
   p.u = region.x + 0.5 * region.width;
   p.v = region.y + 0.5 * region.height;
-  const int step = std::max(1, static_cast<int>(std::sqrt(region.area() / 400.0)));
-  std::vector<uint16_t> values;
-  for (int y = region.y; y < region.y + region.height; y += step) {
-    const auto* row = depth.ptr<uint16_t>(y);
-    for (int x = region.x; x < region.x + region.width; x += step) {
-      if (row[x] > 0) values.push_back(row[x]);
-    }
-  }
+  std::vector<uint16_t> values = sample_valid_depths(depth, region, 400);
   if (values.size() < 10) return p;
   const auto mid = values.begin() + static_cast<long>(values.size() / 2);
   std::nth_element(values.begin(), mid, values.end());
@@ -44,6 +37,21 @@ Patch patch(const cv::Mat& depth, double factor, const cv::Rect2f& box, double x
 }
 
 }  // namespace
+
+std::vector<uint16_t> sample_valid_depths(const cv::Mat& depth_image_raw, const cv::Rect& region_in,
+                                          int max_samples) {
+  const cv::Rect region = region_in & cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
+  std::vector<uint16_t> values;
+  if (region.area() <= 0 || max_samples < 1) return values;
+  const int step = std::max(1, static_cast<int>(std::sqrt(region.area() / static_cast<double>(max_samples))));
+  for (int y = region.y; y < region.y + region.height; y += step) {
+    const auto* row = depth_image_raw.ptr<uint16_t>(y);
+    for (int x = region.x; x < region.x + region.width; x += step) {
+      if (row[x] > 0) values.push_back(row[x]);
+    }
+  }
+  return values;
+}
 
 BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
                             double margin_m) {

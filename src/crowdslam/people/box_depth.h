@@ -12,9 +12,16 @@
 // person, one side as close as they are, still stands out against the pair of the other sides.)
 // Undecidable (kUnknown) without depth, or with patches on fewer than two sides of the box (a box that
 // fills the image's width); those boxes are kept as they are.
+#include <cstdint>
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace crowdslam::people {
+
+// The valid (non-zero) raw depths of `region` (clipped to the image), on a regular grid of about
+// `max_samples` pixels: robust statistics of a region do not need every pixel.
+std::vector<uint16_t> sample_valid_depths(const cv::Mat& depth_image_raw, const cv::Rect& region,
+                                          int max_samples);
 
 enum class BoxDepthVerdict { kStandsOut, kFlat, kUnknown };
 

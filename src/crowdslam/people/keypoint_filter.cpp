@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "crowdslam/people/box_depth.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::people {
@@ -33,15 +34,7 @@ double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor
                cv::Point(cvCeil(centre.x + centre.width), cvCeil(centre.y + centre.height))) &
       cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
   if (region.area() <= 0) return -1.0;
-  // Subsample to at most ~2000 values: the estimate does not need every pixel.
-  const int step = std::max(1, static_cast<int>(std::sqrt(region.area() / 2000.0)));
-  std::vector<uint16_t> values;
-  for (int y = region.y; y < region.y + region.height; y += step) {
-    const auto* row = depth_image_raw.ptr<uint16_t>(y);
-    for (int x = region.x; x < region.x + region.width; x += step) {
-      if (row[x] > 0) values.push_back(row[x]);
-    }
-  }
+  std::vector<uint16_t> values = sample_valid_depths(depth_image_raw, region, 2000);
   if (values.size() < 10) return -1.0;
   const auto nth = values.begin() + static_cast<long>(values.size() * 3 / 10);
   std::nth_element(values.begin(), nth, values.end());

@@ -86,35 +86,20 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
 }
 
 namespace {
-// Reseeds the corners of boxes that have few left (lost to occlusion and the forward-backward check).
-// Reseeds the corners of tracked boxes (no leader) that have few left (lost to occlusion and the
+// Seeds new corners in the boxes tracked by their own flow (no leader; all boxes when `leader` is null):
+// every such box, or with `only_thin` those with few corners left (lost to occlusion and the
 // forward-backward check).
-void reseed_thin(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const std::vector<int>* leader,
-                 const people::BoxFlowOptions& options) {
-  std::vector<size_t> thin;
-  std::vector<people::FlowBox> reseed;
-  for (size_t i = 0; i < boxes.size(); ++i) {
-    if (leader != nullptr && (*leader)[i] >= 0) continue;
-    if (static_cast<int>(boxes[i].points.size()) < 2 * options.min_points) {
-      thin.push_back(i);
-      reseed.push_back(boxes[i]);
-    }
-  }
-  if (reseed.empty()) return;
-  people::seed_points(gray, reseed, options);
-  for (size_t k = 0; k < thin.size(); ++k) boxes[thin[k]].points = std::move(reseed[k].points);
-}
-
-// Seeds corners in the boxes without a leader (all boxes when `leader` is null).
-void seed_leaders(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const std::vector<int>* leader,
-                  const people::BoxFlowOptions& options) {
+void seed_corners(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const std::vector<int>* leader,
+                  const people::BoxFlowOptions& options, bool only_thin) {
   std::vector<size_t> index;
   std::vector<people::FlowBox> seeded;
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (leader != nullptr && (*leader)[i] >= 0) continue;
+    if (only_thin && static_cast<int>(boxes[i].points.size()) >= 2 * options.min_points) continue;
     index.push_back(i);
     seeded.push_back(boxes[i]);
   }
+  if (seeded.empty()) return;
   people::seed_points(gray, seeded, options);
   for (size_t k = 0; k < index.size(); ++k) boxes[index[k]].points = std::move(seeded[k].points);
 }
@@ -205,12 +190,12 @@ void PeopleStage::move_to(const people::FlowImage& image) {
       std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
       if (!boxes.empty()) {
         flow(current_, image, boxes, nullptr, nullptr);
-        reseed_thin(image.gray, boxes, nullptr, flow_options_);
+        seed_corners(image.gray, boxes, nullptr, flow_options_, true);
         tracker_->apply_moved(boxes);
       }
     } else if (!boxes_.empty()) {
       flow(current_, image, boxes_, &nms_, &leader_);
-      reseed_thin(image.gray, boxes_, &leader_, flow_options_);
+      seed_corners(image.gray, boxes_, &leader_, flow_options_, true);
     }
   }
   current_ = image;
@@ -238,7 +223,7 @@ void PeopleStage::take_detection(people::WorkerResult result, const people::Flow
   const bool older = mode_ == DetectorMode::kLatest && !offered_.empty() &&
                      offered_.gray.size() == image.gray.size() && offered_.gray.data != image.gray.data;
   if (older) {
-    seed_leaders(offered_.gray, detected, &leader, flow_options_);
+    seed_corners(offered_.gray, detected, &leader, flow_options_, false);
     flow(offered_, image, detected, &nms, &leader);
   }
   if (tracker_) {
@@ -254,7 +239,7 @@ void PeopleStage::take_detection(people::WorkerResult result, const people::Flow
   } else {
     // The moved boxes keep the corners that followed them; boxes left with few (or none, when the
     // detection is this frame's own) get new ones here.
-    if (mode_ == DetectorMode::kLatest) reseed_thin(image.gray, detected, &leader, flow_options_);
+    if (mode_ == DetectorMode::kLatest) seed_corners(image.gray, detected, &leader, flow_options_, true);
     boxes_ = std::move(detected);
     nms_ = std::move(nms);
     leader_ = std::move(leader);
@@ -349,10 +334,17 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     // Boxes under a tenth of the image are left alone: they cost tracking little, and that is where the
     // test misjudges people (partly in view at the image's edge, or far away among others).
     const double min_area = kFlatTestMinArea * depth_image.cols * depth_image.rows;
+    // The NMS boxes are among the raw boxes too: each box is tested once.
+    std::vector<std::pair<cv::Rect2f, bool>> tested;
     auto flat = [&](const people::PersonBox& b) {
-      return b.box.area() >= min_area &&
-             people::box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict ==
-                 people::BoxDepthVerdict::kFlat;
+      if (b.box.area() < min_area) return false;
+      for (const auto& [box, verdict] : tested) {
+        if (box == b.box) return verdict;
+      }
+      const bool is_flat = people::box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict ==
+                           people::BoxDepthVerdict::kFlat;
+      tested.emplace_back(b.box, is_flat);
+      return is_flat;
     };
     const size_t before = area_boxes.size();
     area_boxes.erase(std::remove_if(area_boxes.begin(), area_boxes.end(), flat), area_boxes.end());
