@@ -253,6 +253,13 @@ run_sanitizer() {
     run_step "$tag map info/export" "$out/map_export.log" \
       "$bin" map export "$out/bonn2.db" --ply "$out/bonn2.ply" --keyframes "$out/bonn2_kf.ply" \
       --trajectory "$out/bonn2_kf.txt" || true
+    # The detector decoupled from tracking (YOLOX ONNX, boxes moved by optical flow between detections,
+    # the box tracker): the detection worker takes the newest frame while tracking goes on.
+    if [[ -f "$shared/models/yolox-nano/yolox_nano.onnx" ]]; then
+      run_step "$tag run bonn_crowd yolox latest + box tracker ($bonn_frames frames)" "$out/run_bonn_latest.log" \
+        "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --detector yolox \
+        --detector-mode latest --box-tracker on --out "$out/run_bonn_latest" || true
+    fi
     # Monocular on the same frames (two-view initialisation, monocular keyframe policy).
     run_step "$tag run bonn_crowd mono ($bonn_frames frames)" "$out/run_bonn_mono.log" \
       "$bin" run --dataset "$bonn" --settings config/Bonn.yaml --frames "$bonn_frames" --sensor mono \
