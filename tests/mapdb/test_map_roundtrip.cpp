@@ -196,11 +196,8 @@ TEST(MapRoundTrip, NoMapPointIsObservedInsideAPersonBox) {
   options.detections_file = people_gt.string();
   options.save_map = (tmp / "crowd.db").string();
   options.settings_path = (tmp / "no_flat.yaml").string();
-  {
-    std::ifstream settings(room / "settings.yaml");
-    std::ofstream copy(options.settings_path);
-    copy << settings.rdbuf() << "\nPeopleFilter.flat_box_margin_m: 0\n";
-  }
+  test::write_text(options.settings_path,
+                   test::read_text(room / "settings.yaml") + "\nPeopleFilter.flat_box_margin_m: 0\n");
   const auto plain = run::run_sequence(options);
   const PointsInBoxes strict = points_in_boxes(tmp / "crowd.db", people_gt, plain.json);
   EXPECT_GT(strict.frames_with_people, 2u);

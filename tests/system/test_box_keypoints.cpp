@@ -37,13 +37,10 @@ std::filesystem::path make_room(const test::TempDir& tmp) {
 run::RunSummary run_room(const std::filesystem::path& dataset, const std::filesystem::path& out,
                          const std::string& static_in_boxes, double flat_box_margin_m = -1.0) {
   const auto settings = out.string() + ".yaml";
-  {
-    std::ifstream in(dataset / "settings.yaml");
-    std::ofstream copy(settings);
-    copy << in.rdbuf() << "\n";
-    if (!static_in_boxes.empty()) copy << "PeopleFilter.static_in_boxes: \"" << static_in_boxes << "\"\n";
-    if (flat_box_margin_m >= 0) copy << "PeopleFilter.flat_box_margin_m: " << flat_box_margin_m << "\n";
-  }
+  std::string text = test::read_text(dataset / "settings.yaml") + "\n";
+  if (!static_in_boxes.empty()) text += "PeopleFilter.static_in_boxes: \"" + static_in_boxes + "\"\n";
+  if (flat_box_margin_m >= 0) text += "PeopleFilter.flat_box_margin_m: " + std::to_string(flat_box_margin_m) + "\n";
+  test::write_text(settings, text);
   run::RunOptions options;
   options.dataset = dataset.string();
   options.settings_path = settings;
