@@ -39,7 +39,9 @@ run::RunSummary run_room(const std::filesystem::path& dataset, const std::filesy
   const auto settings = out.string() + ".yaml";
   std::string text = test::read_text(dataset / "settings.yaml") + "\n";
   if (!static_in_boxes.empty()) text += "PeopleFilter.static_in_boxes: \"" + static_in_boxes + "\"\n";
-  if (flat_box_margin_m >= 0) text += "PeopleFilter.flat_box_margin_m: " + std::to_string(flat_box_margin_m) + "\n";
+  if (flat_box_margin_m >= 0) {
+    text += "PeopleFilter.flat_box_margin_m: " + std::to_string(flat_box_margin_m) + "\n";
+  }
   test::write_text(settings, text);
   run::RunOptions options;
   options.dataset = dataset.string();
