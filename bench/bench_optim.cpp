@@ -38,7 +38,7 @@ void BM_PoseOptimization(benchmark::State& state) {
 }
 BENCHMARK(BM_PoseOptimization)->Arg(200)->Arg(500)->Arg(1500)->Unit(benchmark::kMicrosecond);
 
-// Args: keyframes, points, linear solver (0 auto/sparse, 1 dense). Two fixed keyframes, 20 outliers.
+// Args: keyframes, points, linear solver (0 Ceres sparse Schur, 1 Ceres dense Schur, 2 own Schur LM). Two fixed keyframes, 20 outliers.
 void BM_LocalBundleAdjustment(benchmark::State& state) {
   const PinholeCamera camera = test_camera();
   BaSceneSpec spec;
@@ -46,23 +46,29 @@ void BM_LocalBundleAdjustment(benchmark::State& state) {
   spec.num_points = static_cast<int>(state.range(1));
   const BaScene scene = make_ba_scene(camera, spec);
   BundleAdjustmentOptions options;
-  options.linear_solver = state.range(2) == 0 ? BaLinearSolver::kAuto : BaLinearSolver::kDenseSchur;
+  const BaLinearSolver solvers[] = {BaLinearSolver::kSparseSchur, BaLinearSolver::kDenseSchur, BaLinearSolver::kOwnSchur};
+  options.linear_solver = solvers[state.range(2)];
   int iterations = 0;
+  double final_cost = 0.0;
   for (auto _ : state) {
     const BundleAdjustmentResult result =
         local_bundle_adjustment(camera, scene.keyframes, scene.points, scene.observations, options);
     iterations = result.iterations;
+    final_cost = result.final_cost;
     benchmark::DoNotOptimize(result.points.data());
   }
   state.counters["observations"] = static_cast<double>(scene.observations.size());
-  state.counters["ceres_iterations"] = iterations;
+  state.counters["iterations"] = iterations;
+  state.counters["final_cost"] = final_cost;
   state.counters["sparse_backend"] = ceres_has_sparse_backend() ? 1 : 0;
 }
 BENCHMARK(BM_LocalBundleAdjustment)
     ->Args({10, 500, 0})
     ->Args({10, 500, 1})
+    ->Args({10, 500, 2})
     ->Args({20, 2000, 0})
     ->Args({20, 2000, 1})
+    ->Args({20, 2000, 2})
     ->Unit(benchmark::kMillisecond);
 
 // Args: nodes, covisibility neighbours per node (edges ~ nodes * neighbours), scale (0 fixed, 1 free).

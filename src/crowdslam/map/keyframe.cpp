@@ -89,6 +89,14 @@ int KeyFrame::tracked_map_points(int min_observations) const {
   return count;
 }
 
+int KeyFrame::found_map_points(int min_found) const {
+  int count = 0;
+  for (const auto& p : map_points()) {
+    if (p && !p->is_bad() && p->found_count() >= min_found) ++count;
+  }
+  return count;
+}
+
 // ---- covisibility ----
 void KeyFrame::update_best_covisibles_locked() {
   ordered_connections_.clear();

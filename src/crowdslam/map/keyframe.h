@@ -48,6 +48,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   [[nodiscard]] std::vector<std::shared_ptr<MapPoint>> valid_map_points() const;  // non-null, not bad
   // Number of good points with at least `min_observations` observations.
   [[nodiscard]] int tracked_map_points(int min_observations) const;
+  // Number of good points that tracking has matched in at least `min_found` frames (MapPoint::found_count).
+  [[nodiscard]] int found_map_points(int min_found) const;
 
   // Covisibility graph: weight = number of shared map points.
   void update_connections();  // recompute from the map points (edge threshold 15, else the best one)

@@ -2,6 +2,7 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <unordered_map>
 
 #include "crowdslam/optim/ceres_pose.h"
+#include "crowdslam/optim/schur_lm.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::optim {
@@ -115,9 +117,60 @@ class BaSolver {
     return obs.inv_sigma2 * error2 > (is_stereo(obs) ? options_.chi2_stereo : options_.chi2_mono);
   }
 
-  // One Ceres solve over the observations with active[i] set.
-  ceres::Solver::Summary solve(const std::vector<bool>& active, bool robust, int iterations,
-                               const std::atomic<bool>* abort_flag) {
+  struct PassSummary {
+    double initial_cost = 0.0;
+    double final_cost = 0.0;
+    int iterations = 0;
+  };
+
+  // One solve over the observations with active[i] set.
+  PassSummary solve(const std::vector<bool>& active, bool robust, int iterations, const std::atomic<bool>* abort_flag) {
+    if (use_own_solver()) return solve_own(active, robust, iterations, abort_flag);
+    const ceres::Solver::Summary summary = solve_ceres(active, robust, iterations, abort_flag);
+    return {summary.initial_cost, summary.final_cost, summary.num_successful_steps + summary.num_unsuccessful_steps};
+  }
+
+ private:
+  [[nodiscard]] bool use_own_solver() const {
+    if (options_.linear_solver == BaLinearSolver::kOwnSchur) return true;
+    if (options_.linear_solver != BaLinearSolver::kAuto) return false;
+    const auto free = std::count_if(keyframes_.begin(), keyframes_.end(), [](const BaKeyframe& k) { return !k.fixed; });
+    return free <= kOwnSchurMaxFreePoses;
+  }
+
+  PassSummary solve_own(const std::vector<bool>& active, bool robust, int iterations,
+                        const std::atomic<bool>* abort_flag) {
+    std::vector<SE3> poses;
+    std::vector<bool> fixed;
+    poses.reserve(state_.poses.size());
+    for (std::size_t k = 0; k < state_.poses.size(); ++k) {
+      poses.push_back(from_pose_block(state_.poses[k]));
+      fixed.push_back(keyframes_[k].fixed);
+    }
+    std::vector<SchurObservation> observations;
+    observations.reserve(observations_.size());
+    for (std::size_t i = 0; i < observations_.size(); ++i) {
+      if (!active[i]) continue;
+      const BaObservation& obs = observations_[i];
+      SchurObservation o;
+      o.pose = state_.obs_keyframe[i];
+      o.point = state_.obs_point[i];
+      o.pixel = obs.pixel;
+      o.stereo = is_stereo(obs);
+      o.right_u = obs.right_u;
+      o.sqrt_information = std::sqrt(obs.inv_sigma2);
+      o.huber_delta = robust ? std::sqrt(o.stereo ? options_.chi2_stereo : options_.chi2_mono) : 0.0;
+      observations.push_back(o);
+    }
+    const SchurLmSummary summary = solve_schur_lm(camera_, poses, fixed, state_.points, observations, iterations, abort_flag);
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      if (!fixed[k]) state_.poses[k] = to_pose_block(poses[k]);
+    }
+    return {summary.initial_cost, summary.final_cost, summary.successful_steps + summary.unsuccessful_steps};
+  }
+
+  ceres::Solver::Summary solve_ceres(const std::vector<bool>& active, bool robust, int iterations,
+                                     const std::atomic<bool>* abort_flag) {
     ceres::Problem::Options problem_options;
     problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -171,7 +224,6 @@ class BaSolver {
     return summary;
   }
 
- private:
   const PinholeCamera& camera_;
   const std::vector<BaKeyframe>& keyframes_;
   const std::vector<BaObservation>& observations_;
@@ -200,17 +252,16 @@ BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera, cons
   std::vector<bool> active(observations.size());
   for (std::size_t i = 0; i < observations.size(); ++i) active[i] = state.obs_keyframe[i] >= 0;
 
-  const ceres::Solver::Summary first = solver.solve(active, /*robust=*/true, options.first_pass_iterations, abort_flag);
-  result.iterations += first.num_successful_steps + first.num_unsuccessful_steps;
+  const auto first = solver.solve(active, /*robust=*/true, options.first_pass_iterations, abort_flag);
+  result.iterations += first.iterations;
   result.initial_cost = first.initial_cost;
   result.final_cost = first.final_cost;
   result.aborted = aborted(abort_flag);
 
   if (!result.aborted && options.second_pass_iterations > 0) {
     for (std::size_t i = 0; i < observations.size(); ++i) active[i] = active[i] && !solver.is_outlier(i);
-    const ceres::Solver::Summary second =
-        solver.solve(active, /*robust=*/false, options.second_pass_iterations, abort_flag);
-    result.iterations += second.num_successful_steps + second.num_unsuccessful_steps;
+    const auto second = solver.solve(active, /*robust=*/false, options.second_pass_iterations, abort_flag);
+    result.iterations += second.iterations;
     result.final_cost = second.final_cost;
     result.aborted = aborted(abort_flag);
   }

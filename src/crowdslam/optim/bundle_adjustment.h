@@ -1,5 +1,5 @@
 #pragma once
-// Local bundle adjustment (local mapping) with Ceres on plain data: keyframe poses
+// Local bundle adjustment (local mapping) with our Schur LM (schur_lm.h) or Ceres on plain data: keyframe poses
 // (cam_from_world, Se3Manifold) and 3D points. Independent of the map module: the mapper copies
 // its local window into these structs and writes the result back.
 //
@@ -42,10 +42,14 @@ struct BaObservation {
 };
 
 enum class BaLinearSolver {
-  kAuto,         // SPARSE_SCHUR when Ceres has a sparse backend, else DENSE_SCHUR
-  kSparseSchur,  // falls back to DENSE_SCHUR when no sparse backend is compiled in
-  kDenseSchur,
+  kAuto,         // kOwnSchur up to kOwnSchurMaxFreePoses free poses (local windows), else Ceres kSparseSchur
+  kSparseSchur,  // Ceres SPARSE_SCHUR; falls back to DENSE_SCHUR when no sparse backend is compiled in
+  kDenseSchur,   // Ceres DENSE_SCHUR
+  kOwnSchur,     // optim::solve_schur_lm (schur_lm.h): the same problem, static block sizes, dense Cholesky
 };
+
+// kAuto's limit for kOwnSchur: its reduced camera system is dense (6 x free poses squared).
+constexpr int kOwnSchurMaxFreePoses = 64;
 
 struct BundleAdjustmentOptions {
   int first_pass_iterations = 5;
@@ -64,7 +68,7 @@ struct BundleAdjustmentResult {
   std::vector<BaPoint> points;        // input order
   std::vector<std::size_t> outliers;  // indices into the input observations, ascending
   bool aborted = false;
-  int iterations = 0;  // Ceres iterations over both passes
+  int iterations = 0;  // solver iterations (linear solves) over both passes
   double initial_cost = 0.0;
   double final_cost = 0.0;  // of the last pass run (robust cost if pass 2 did not run)
 };

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <numeric>
 #include <unordered_map>
@@ -35,6 +36,7 @@ void TrackerOptions::check() const {
   if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
   if (max_frames_between_keyframes < 1) throw InputError("tracker: max frames between keyframes must be >= 1");
   if (keyframe_reference_min_observations < 1) throw InputError("tracker: keyframe_reference_min_observations must be >= 1");
+  if (keyframe_reference_min_found < 0) throw InputError("tracker: keyframe_reference_min_found must be >= 0");
   pose.check();
   dynamic.check();
   if (monocular) monocular_init.check();
@@ -488,7 +490,12 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
     return KeyframeDecision::kNo;
   }
   const int min_observations = num_keyframes <= 2 ? 2 : options_.keyframe_reference_min_observations;
-  const int reference_matches = reference_keyframe_ ? reference_keyframe_->tracked_map_points(min_observations) : 0;
+  const int min_found = options_.keyframe_reference_min_found;
+  int reference_matches = 0;
+  if (reference_keyframe_) {
+    reference_matches = min_found > 0 ? reference_keyframe_->found_map_points(min_found)
+                                      : reference_keyframe_->tracked_map_points(min_observations);
+  }
   const bool mapper_idle = mapper_->accepts_keyframes();
 
   // Close points (reliable depth) tracked vs. not tracked.

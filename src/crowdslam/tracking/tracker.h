@@ -50,6 +50,13 @@ struct TrackerOptions {
   // on the synthetic rooms 24-26 keyframes in 300 frames against 110-136 sequential, at 3x the ATE
   // (docs/DYNAMIC.md). With 2 the threaded rooms make 56-63.
   int keyframe_reference_min_observations = 2;
+  // RGB-D / stereo, when > 0 (replaces the observation count above): the reference keyframe's points
+  // counted are those tracking has matched in at least this many frames. With observations, a point
+  // counts once a second keyframe sees it, but 30-40 % of those are not re-detected in the next frame
+  // (ORB repeatability), so the ratio test failed on every frame and an idle mapper meant a keyframe
+  // per frame (sequential bonn_crowd: 214 of 927); found counts are frames, not keyframes, so they
+  // neither inflate with new keyframes nor thin out when keyframes are sparse (docs/RESULTS.md).
+  int keyframe_reference_min_found = 3;
   int reset_if_lost_within_keyframes = 5;  // lost with so few keyframes: reset the map and start again
   // Lost for this many frames in a row without relocalising: start a new map (0 = never; ORB-SLAM2 stays
   // lost until the camera returns, ORB-SLAM3's Atlas starts a new map at once). The camera is somewhere the
