@@ -38,7 +38,8 @@ void BM_PoseOptimization(benchmark::State& state) {
 }
 BENCHMARK(BM_PoseOptimization)->Arg(200)->Arg(500)->Arg(1500)->Unit(benchmark::kMicrosecond);
 
-// Args: keyframes, points, linear solver (0 Ceres sparse Schur, 1 Ceres dense Schur, 2 own Schur LM). Two fixed keyframes, 20 outliers.
+// Args: keyframes, points, linear solver (0 Ceres sparse Schur, 1 Ceres dense Schur, 2 own Schur LM). Two
+// fixed keyframes, 20 outliers.
 void BM_LocalBundleAdjustment(benchmark::State& state) {
   const PinholeCamera camera = test_camera();
   BaSceneSpec spec;
@@ -46,7 +47,8 @@ void BM_LocalBundleAdjustment(benchmark::State& state) {
   spec.num_points = static_cast<int>(state.range(1));
   const BaScene scene = make_ba_scene(camera, spec);
   BundleAdjustmentOptions options;
-  const BaLinearSolver solvers[] = {BaLinearSolver::kSparseSchur, BaLinearSolver::kDenseSchur, BaLinearSolver::kOwnSchur};
+  const BaLinearSolver solvers[] = {BaLinearSolver::kSparseSchur, BaLinearSolver::kDenseSchur,
+                                    BaLinearSolver::kOwnSchur};
   options.linear_solver = solvers[state.range(2)];
   int iterations = 0;
   double final_cost = 0.0;

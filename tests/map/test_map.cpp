@@ -28,12 +28,14 @@ std::shared_ptr<FrameFeatures> make_features(size_t n, unsigned seed) {
   std::mt19937 rng(seed);
   f->descriptors = cv::Mat(static_cast<int>(n), 32, CV_8UC1);
   for (size_t i = 0; i < n; ++i) {
-    cv::KeyPoint kp(cv::Point2f(10.0f + 7.0f * (i % 80), 10.0f + 7.0f * (i / 80)), 31.0f, 0, 1, static_cast<int>(i % 3));
+    cv::KeyPoint kp(cv::Point2f(10.0f + 7.0f * (i % 80), 10.0f + 7.0f * (i / 80)), 31.0f, 0, 1,
+                    static_cast<int>(i % 3));
     f->keys.push_back(kp);
     f->keys_un.push_back(kp);
     f->depth_m.push_back(i % 2 == 0 ? 2.0f : -1.0f);
     f->right_u.push_back(i % 2 == 0 ? kp.pt.x - 20.0f : -1.0f);
-    for (int b = 0; b < 32; ++b) f->descriptors.at<uint8_t>(static_cast<int>(i), b) = static_cast<uint8_t>(rng());
+    for (int b = 0; b < 32; ++b)
+      f->descriptors.at<uint8_t>(static_cast<int>(i), b) = static_cast<uint8_t>(rng());
   }
   f->grid = FeatureGrid(f->keys_un, geometry::ImageBounds{0, 640, 0, 480});
   return f;
@@ -96,9 +98,9 @@ TEST(ScaleLevels, GeometricSeries) {
 TEST(Covisibility, WeightsCountSharedPointsAndThresholdApplies) {
   TestMap t;
   auto a = t.add_keyframe(), b = t.add_keyframe(), c = t.add_keyframe();
-  for (size_t i = 0; i < 20; ++i) t.add_point({a, b}, i);      // a-b share 20
-  for (size_t i = 20; i < 25; ++i) t.add_point({a, c}, i);     // a-c share 5 (< 15)
-  for (size_t i = 30; i < 60; ++i) t.add_point({b, c}, i);     // b-c share 30
+  for (size_t i = 0; i < 20; ++i) t.add_point({a, b}, i);   // a-b share 20
+  for (size_t i = 20; i < 25; ++i) t.add_point({a, c}, i);  // a-c share 5 (< 15)
+  for (size_t i = 30; i < 60; ++i) t.add_point({b, c}, i);  // b-c share 30
   a->update_connections();
   EXPECT_EQ(a->weight(b->id), 20);
   EXPECT_EQ(a->weight(c->id), 0);  // below threshold, and a strong edge exists
@@ -147,6 +149,26 @@ TEST(MapPoint, StereoObservationsCountTwiceAndPointDiesWithFewObservations) {
   EXPECT_EQ(b->map_point(1), nullptr);
   EXPECT_EQ(t.map.erase_bad_map_points(), 1u);
   EXPECT_EQ(t.map.num_map_points(), 1u);
+}
+
+TEST(KeyFrame, FoundMapPointsCountsFramesNotKeyframes) {
+  // The RGB-D / stereo keyframe policy's reference count: points matched by tracking in >= n frames,
+  // whatever number of keyframes observes them (tracked_map_points counts keyframe observations).
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe();
+  auto seen_once = t.add_point({a}, 1);    // found 1 (its creation), 1 keyframe
+  auto found_often = t.add_point({a}, 3);  // 1 keyframe, but tracked in 4 more frames
+  found_often->increase_found(4);
+  auto two_keyframes = t.add_point({a, b}, 5);  // 2 keyframes, never tracked since
+  auto bad = t.add_point({a}, 7);
+  bad->increase_found(9);
+  bad->set_bad();
+  EXPECT_EQ(seen_once->found_count(), 1);
+  EXPECT_EQ(a->found_map_points(1), 3);
+  EXPECT_EQ(a->found_map_points(3), 1);  // found_often only; the bad point never counts
+  EXPECT_EQ(a->found_map_points(6), 0);
+  EXPECT_EQ(a->tracked_map_points(2), 1);  // two_keyframes: the observation count tells another story
+  EXPECT_EQ(b->found_map_points(2), 0);
 }
 
 TEST(MapPoint, DistinctiveDescriptorIsTheMedoid) {

@@ -22,8 +22,8 @@ struct Problem {
   std::vector<SchurObservation> observations;
 };
 
-Problem to_problem(const PinholeCamera& camera, const BaScene& scene, const std::vector<BaKeyframe>& keyframes,
-                   const std::vector<BaPoint>& points) {
+Problem to_problem(const PinholeCamera& camera, const BaScene& scene,
+                   const std::vector<BaKeyframe>& keyframes, const std::vector<BaPoint>& points) {
   Problem problem;
   for (const BaKeyframe& k : keyframes) {
     problem.poses.push_back(k.cam_from_world);
@@ -64,14 +64,14 @@ TEST(SchurLm, InitialCostIsHalfTheHuberSumInClosedForm) {
   const double s = 1.5 * 1.5 + 2.0 * 2.0 + 6.0 * 6.0;
 
   auto plain = problem;
-  const SchurLmSummary a =
-      solve_schur_lm(camera, plain.poses, plain.fixed, plain.points, plain.observations, /*max_iterations=*/0);
+  const SchurLmSummary a = solve_schur_lm(camera, plain.poses, plain.fixed, plain.points, plain.observations,
+                                          /*max_iterations=*/0);
   EXPECT_NEAR(a.initial_cost, 0.5 * s, 1e-9);
 
   auto robust = problem;
   robust.observations[0].huber_delta = 2.0;  // s > delta^2: rho = 2 delta sqrt(s) - delta^2
-  const SchurLmSummary b =
-      solve_schur_lm(camera, robust.poses, robust.fixed, robust.points, robust.observations, /*max_iterations=*/0);
+  const SchurLmSummary b = solve_schur_lm(camera, robust.poses, robust.fixed, robust.points,
+                                          robust.observations, /*max_iterations=*/0);
   EXPECT_NEAR(b.initial_cost, 0.5 * (2.0 * 2.0 * std::sqrt(s) - 4.0), 1e-9);
   EXPECT_EQ(b.successful_steps + b.unsuccessful_steps, 0);
 }
@@ -170,6 +170,7 @@ TEST(SchurLm, ReachesTheSameMinimumAsCeres) {
     EXPECT_LT(rotation_error_rad(a.keyframes[k].cam_from_world, b.keyframes[k].cam_from_world), 1.7e-4) << k;
   }
   double point_gap = 0.0;
-  for (std::size_t p = 0; p < a.points.size(); ++p) point_gap += (a.points[p].world - b.points[p].world).norm();
+  for (std::size_t p = 0; p < a.points.size(); ++p)
+    point_gap += (a.points[p].world - b.points[p].world).norm();
   EXPECT_LT(point_gap / a.points.size(), 1e-3);
 }

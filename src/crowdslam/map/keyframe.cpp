@@ -10,8 +10,8 @@ namespace crowdslam::map {
 
 KeyFrame::KeyFrame(uint64_t id_in, uint64_t frame_id_in, double timestamp_s_in,
                    std::shared_ptr<const geometry::PinholeCamera> camera_in,
-                   std::shared_ptr<const ScaleLevels> levels_in, std::shared_ptr<const FrameFeatures> features_in,
-                   const geometry::SE3& cam_from_world)
+                   std::shared_ptr<const ScaleLevels> levels_in,
+                   std::shared_ptr<const FrameFeatures> features_in, const geometry::SE3& cam_from_world)
     : id(id_in),
       frame_id(frame_id_in),
       timestamp_s(timestamp_s_in),
@@ -100,7 +100,8 @@ int KeyFrame::found_map_points(int min_found) const {
 // ---- covisibility ----
 void KeyFrame::update_best_covisibles_locked() {
   ordered_connections_.clear();
-  for (const auto& [other_id, link] : connections_) ordered_connections_.emplace_back(link.second, link.first);
+  for (const auto& [other_id, link] : connections_)
+    ordered_connections_.emplace_back(link.second, link.first);
   std::stable_sort(ordered_connections_.begin(), ordered_connections_.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
 }

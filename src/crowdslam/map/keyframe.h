@@ -22,9 +22,9 @@ class Map;
 
 class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
  public:
-  KeyFrame(uint64_t id, uint64_t frame_id, double timestamp_s, std::shared_ptr<const geometry::PinholeCamera> camera,
-           std::shared_ptr<const ScaleLevels> levels, std::shared_ptr<const FrameFeatures> features,
-           const geometry::SE3& cam_from_world);
+  KeyFrame(uint64_t id, uint64_t frame_id, double timestamp_s,
+           std::shared_ptr<const geometry::PinholeCamera> camera, std::shared_ptr<const ScaleLevels> levels,
+           std::shared_ptr<const FrameFeatures> features, const geometry::SE3& cam_from_world);
 
   const uint64_t id;
   const uint64_t frame_id;
@@ -44,7 +44,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void erase_map_point(size_t index);
   void replace_map_point(size_t index, const std::shared_ptr<MapPoint>& point);
   [[nodiscard]] std::shared_ptr<MapPoint> map_point(size_t index) const;
-  [[nodiscard]] std::vector<std::shared_ptr<MapPoint>> map_points() const;  // copy, with nulls
+  [[nodiscard]] std::vector<std::shared_ptr<MapPoint>> map_points() const;        // copy, with nulls
   [[nodiscard]] std::vector<std::shared_ptr<MapPoint>> valid_map_points() const;  // non-null, not bad
   // Number of good points with at least `min_observations` observations.
   [[nodiscard]] int tracked_map_points(int min_observations) const;
@@ -87,7 +87,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
 
   // Median depth of the map points seen (q = 2: median), for scaling and keyframe policy.
   [[nodiscard]] float scene_median_depth() const;
-  [[nodiscard]] bool is_in_image(double u, double v) const { return features->grid.bounds().contains({u, v}); }
+  [[nodiscard]] bool is_in_image(double u, double v) const {
+    return features->grid.bounds().contains({u, v});
+  }
 
  private:
   void update_best_covisibles_locked();
@@ -103,7 +105,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::map<uint64_t, std::pair<std::weak_ptr<KeyFrame>, int>> connections_;
   std::vector<std::pair<int, std::weak_ptr<KeyFrame>>> ordered_connections_;  // weight desc
   bool first_connection_ = true;
-  std::shared_ptr<KeyFrame> parent_;  // strong: a bad keyframe keeps its chain to the tree (trajectory output)
+  std::shared_ptr<KeyFrame>
+      parent_;  // strong: a bad keyframe keeps its chain to the tree (trajectory output)
   std::map<uint64_t, std::weak_ptr<KeyFrame>> children_;
   std::map<uint64_t, std::weak_ptr<KeyFrame>> loop_edges_;
   bool not_erase_ = false;

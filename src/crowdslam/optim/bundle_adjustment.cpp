@@ -45,14 +45,17 @@ class AbortCallback final : public ceres::IterationCallback {
   explicit AbortCallback(const std::atomic<bool>* flag) : flag_(flag) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& /*summary*/) override {
     // TERMINATE_SUCCESSFULLY keeps the last accepted state in the parameter blocks.
-    return flag_->load(std::memory_order_relaxed) ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+    return flag_->load(std::memory_order_relaxed) ? ceres::SOLVER_TERMINATE_SUCCESSFULLY
+                                                  : ceres::SOLVER_CONTINUE;
   }
 
  private:
   const std::atomic<bool>* flag_;
 };
 
-bool aborted(const std::atomic<bool>* flag) { return flag != nullptr && flag->load(std::memory_order_relaxed); }
+bool aborted(const std::atomic<bool>* flag) {
+  return flag != nullptr && flag->load(std::memory_order_relaxed);
+}
 
 // Parameter storage plus, per observation, the indices of its keyframe and point (-1: unknown id).
 struct BaState {
@@ -97,8 +100,13 @@ ceres::LinearSolverType linear_solver_type(BaLinearSolver choice) {
 class BaSolver {
  public:
   BaSolver(const PinholeCamera& camera, const std::vector<BaKeyframe>& keyframes,
-           const std::vector<BaObservation>& observations, const BundleAdjustmentOptions& options, BaState& state)
-      : camera_(camera), keyframes_(keyframes), observations_(observations), options_(options), state_(state) {}
+           const std::vector<BaObservation>& observations, const BundleAdjustmentOptions& options,
+           BaState& state)
+      : camera_(camera),
+        keyframes_(keyframes),
+        observations_(observations),
+        options_(options),
+        state_(state) {}
 
   [[nodiscard]] bool is_stereo(const BaObservation& obs) const { return obs.is_stereo() && camera_.bf > 0.0; }
 
@@ -124,17 +132,20 @@ class BaSolver {
   };
 
   // One solve over the observations with active[i] set.
-  PassSummary solve(const std::vector<bool>& active, bool robust, int iterations, const std::atomic<bool>* abort_flag) {
+  PassSummary solve(const std::vector<bool>& active, bool robust, int iterations,
+                    const std::atomic<bool>* abort_flag) {
     if (use_own_solver()) return solve_own(active, robust, iterations, abort_flag);
     const ceres::Solver::Summary summary = solve_ceres(active, robust, iterations, abort_flag);
-    return {summary.initial_cost, summary.final_cost, summary.num_successful_steps + summary.num_unsuccessful_steps};
+    return {summary.initial_cost, summary.final_cost,
+            summary.num_successful_steps + summary.num_unsuccessful_steps};
   }
 
  private:
   [[nodiscard]] bool use_own_solver() const {
     if (options_.linear_solver == BaLinearSolver::kOwnSchur) return true;
     if (options_.linear_solver != BaLinearSolver::kAuto) return false;
-    const auto free = std::count_if(keyframes_.begin(), keyframes_.end(), [](const BaKeyframe& k) { return !k.fixed; });
+    const auto free =
+        std::count_if(keyframes_.begin(), keyframes_.end(), [](const BaKeyframe& k) { return !k.fixed; });
     return free <= kOwnSchurMaxFreePoses;
   }
 
@@ -162,7 +173,8 @@ class BaSolver {
       o.huber_delta = robust ? std::sqrt(o.stereo ? options_.chi2_stereo : options_.chi2_mono) : 0.0;
       observations.push_back(o);
     }
-    const SchurLmSummary summary = solve_schur_lm(camera_, poses, fixed, state_.points, observations, iterations, abort_flag);
+    const SchurLmSummary summary =
+        solve_schur_lm(camera_, poses, fixed, state_.points, observations, iterations, abort_flag);
     for (std::size_t k = 0; k < poses.size(); ++k) {
       if (!fixed[k]) state_.poses[k] = to_pose_block(poses[k]);
     }
@@ -194,8 +206,9 @@ class BaSolver {
       }
       point_used[p] = true;
       if (is_stereo(obs)) {
-        problem.AddResidualBlock(new StereoReprojectionCost(cost_camera, obs.pixel, obs.right_u, obs.inv_sigma2),
-                                 robust ? &stereo_loss : nullptr, pose, point);
+        problem.AddResidualBlock(
+            new StereoReprojectionCost(cost_camera, obs.pixel, obs.right_u, obs.inv_sigma2),
+            robust ? &stereo_loss : nullptr, pose, point);
       } else {
         problem.AddResidualBlock(new MonoReprojectionCost(cost_camera, obs.pixel, obs.inv_sigma2),
                                  robust ? &mono_loss : nullptr, pose, point);
@@ -234,7 +247,8 @@ class BaSolver {
 
 }  // namespace
 
-BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera, const std::vector<BaKeyframe>& keyframes,
+BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera,
+                                               const std::vector<BaKeyframe>& keyframes,
                                                const std::vector<BaPoint>& points,
                                                const std::vector<BaObservation>& observations,
                                                const BundleAdjustmentOptions& options,

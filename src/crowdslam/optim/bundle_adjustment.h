@@ -1,7 +1,7 @@
 #pragma once
-// Local bundle adjustment (local mapping) with our Schur LM (schur_lm.h) or Ceres on plain data: keyframe poses
-// (cam_from_world, Se3Manifold) and 3D points. Independent of the map module: the mapper copies
-// its local window into these structs and writes the result back.
+// Local bundle adjustment (local mapping) with our Schur LM (schur_lm.h) or Ceres on plain data: keyframe
+// poses (cam_from_world, Se3Manifold) and 3D points. Independent of the map module: the mapper copies its
+// local window into these structs and writes the result back.
 //
 // Schedule (ORB-SLAM2 style):
 //   pass 1: all observations, Huber loss (delta^2 = chi2 threshold), first_pass_iterations;

@@ -57,8 +57,8 @@ class Problem {
   }
 
   // 1/2 sum rho; false if some observation cannot be evaluated.
-  bool cost(const std::vector<SE3>& poses, const std::vector<Mat3>& rotations, const std::vector<Vec3>& points,
-            double& total) const {
+  bool cost(const std::vector<SE3>& poses, const std::vector<Mat3>& rotations,
+            const std::vector<Vec3>& points, double& total) const {
     total = 0.0;
     Vec3 r;
     Vec3 p_cam;
@@ -130,7 +130,8 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
   std::vector<int> by_point(observations.size());
   {
     std::vector<int> next(point_start.begin(), point_start.end() - 1);
-    for (size_t i = 0; i < observations.size(); ++i) by_point[next[observations[i].point]++] = static_cast<int>(i);
+    for (size_t i = 0; i < observations.size(); ++i)
+      by_point[next[observations[i].point]++] = static_cast<int>(i);
   }
 
   std::vector<Mat6> u(num_free);

@@ -3,8 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
+#include <cstdlib>
 #include <numeric>
 #include <unordered_map>
 #include <unordered_set>
@@ -34,9 +34,12 @@ const char* to_string(TrackingState state) {
 void TrackerOptions::check() const {
   if (!(close_depth_m > 0)) throw InputError("tracker: close depth (ThDepth) must be > 0");
   if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
-  if (max_frames_between_keyframes < 1) throw InputError("tracker: max frames between keyframes must be >= 1");
-  if (keyframe_reference_min_observations < 1) throw InputError("tracker: keyframe_reference_min_observations must be >= 1");
-  if (keyframe_reference_min_found < 0) throw InputError("tracker: keyframe_reference_min_found must be >= 0");
+  if (max_frames_between_keyframes < 1)
+    throw InputError("tracker: max frames between keyframes must be >= 1");
+  if (keyframe_reference_min_observations < 1)
+    throw InputError("tracker: keyframe_reference_min_observations must be >= 1");
+  if (keyframe_reference_min_found < 0)
+    throw InputError("tracker: keyframe_reference_min_found must be >= 0");
   pose.check();
   dynamic.check();
   if (monocular) monocular_init.check();
@@ -123,7 +126,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       }
       dynamic_check_.set_suspended(false);
     }
-    if (boxes && options_.box_keypoints && (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking)) {
+    if (boxes && options_.box_keypoints &&
+        (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking)) {
       if (auto full = with_box_keypoints(frame, ok, boxes, result.static_boxes)) {
         if (!ok) {
           result.method = "motion+boxes";
@@ -156,7 +160,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     }
     if (ok && boxes.box_of.size() == frame.size()) {  // the frame has its box keypoints back
       for (size_t i = 0; i < frame.size(); ++i) {
-        if (boxes.box_of[i] >= 0 && frame.map_points[i] && !frame.outliers[i] && !frame.dynamic[i]) ++result.box_matches;
+        if (boxes.box_of[i] >= 0 && frame.map_points[i] && !frame.outliers[i] && !frame.dynamic[i])
+          ++result.box_matches;
       }
     }
     if (ok) {
@@ -192,7 +197,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     } else {
       velocity_.reset();
       ++lost_frames_;
-      if (!map_loaded_ && map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
+      if (!map_loaded_ &&
+          map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
         result.map_reset = true;
       } else if (!map_loaded_ && options_.new_map_after_lost_frames > 0 &&
@@ -226,8 +232,9 @@ bool Tracker::initialize(map::Frame& frame) {
   if (with_depth < options_.min_init_features) return false;
 
   frame.cam_from_world = geometry::SE3::identity();
-  auto keyframe = std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
-                                                  frame.levels, frame.features, *frame.cam_from_world);
+  auto keyframe =
+      std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
+                                      frame.levels, frame.features, *frame.cam_from_world);
   map_->add_keyframe(keyframe);
   for (size_t i = 0; i < f.size(); ++i) {
     if (f.depth_m[i] <= 0) continue;
@@ -251,7 +258,8 @@ std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& 
                                                               size_t keyframe_index) const {
   const auto& f = *frame.features;
   const geometry::Vec2 pixel(f.keys_un[index].pt.x, f.keys_un[index].pt.y);
-  const geometry::Vec3 world = frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[index]);
+  const geometry::Vec3 world =
+      frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[index]);
   auto point = std::make_shared<map::MapPoint>(map_->next_map_point_id(), world, keyframe, frame.id);
   point->add_observation(keyframe, keyframe_index);
   keyframe->add_map_point(keyframe_index, point);
@@ -473,7 +481,8 @@ bool Tracker::track_local_map(map::Frame& frame) {
   }
   inliers_in_local_map_ = inliers;
   const bool recently_relocalized =
-      frame.id < last_relocalization_frame_id_ + static_cast<uint64_t>(options_.max_frames_between_keyframes) &&
+      frame.id <
+          last_relocalization_frame_id_ + static_cast<uint64_t>(options_.max_frames_between_keyframes) &&
       last_relocalization_frame_id_ > 0;
   if (recently_relocalized && inliers < 50) return false;
   return inliers >= 30;
@@ -514,10 +523,12 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
   const bool need_close = tracked_close < 100 && untracked_close > 70;
   const double ref_ratio = num_keyframes < 2 ? 0.4 : options_.keyframe_reference_ratio;
   const bool c1a = frame.id >= last_keyframe_frame_id_ + max_frames;
-  const bool c1b = frame.id >= last_keyframe_frame_id_ + static_cast<uint64_t>(options_.min_frames_between_keyframes) &&
-                   mapper_idle;
+  const bool c1b =
+      frame.id >= last_keyframe_frame_id_ + static_cast<uint64_t>(options_.min_frames_between_keyframes) &&
+      mapper_idle;
   const bool c1c = inliers_in_local_map_ < reference_matches * 0.25 || need_close;
-  const bool c2 = (inliers_in_local_map_ < reference_matches * ref_ratio || need_close) && inliers_in_local_map_ > 15;
+  const bool c2 =
+      (inliers_in_local_map_ < reference_matches * ref_ratio || need_close) && inliers_in_local_map_ > 15;
   if (!((c1a || c1b || c1c) && c2)) return KeyframeDecision::kNo;
   if (mapper_idle) return KeyframeDecision::kInsert;
   mapper_->interrupt_bundle_adjustment();
@@ -546,8 +557,9 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
     to_keyframe.resize(frame.size());
     std::iota(to_keyframe.begin(), to_keyframe.end(), 0L);
   }
-  auto keyframe = std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
-                                                  frame.levels, features, *frame.cam_from_world);
+  auto keyframe =
+      std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
+                                      frame.levels, features, *frame.cam_from_world);
   // The keyframe takes the frame's current matches (the mapper adds the observations).
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     if (to_keyframe[i] >= 0 && frame.map_points[i] && !frame.outliers[i] && !frame.map_points[i]->is_bad()) {

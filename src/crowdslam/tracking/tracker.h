@@ -28,8 +28,8 @@ enum class TrackingState { kNotInitialized, kOk, kLost };
 const char* to_string(TrackingState state);
 
 struct TrackerOptions {
-  double close_depth_m = 3.0;         // "close" points (ThDepth * baseline): reliable depth
-  int min_init_features = 500;        // keypoints with depth needed to initialise (RGB-D)
+  double close_depth_m = 3.0;             // "close" points (ThDepth * baseline): reliable depth
+  int min_init_features = 500;            // keypoints with depth needed to initialise (RGB-D)
   int max_frames_between_keyframes = 30;  // usually the camera fps
   // Backpressure: when a keyframe is needed urgently and local mapping is behind, tracking waits for it
   // up to this long (with the map unlocked) instead of going on without the keyframe and losing track.
@@ -43,8 +43,9 @@ struct TrackerOptions {
   // A keyframe is due when the frame tracks fewer than this fraction of its reference keyframe's points
   // (ORB-SLAM2 uses 0.75 for RGB-D; more keyframes measured better, see docs/RESULTS.md).
   double keyframe_reference_ratio = 0.9;
-  // RGB-D / stereo: the reference keyframe's points counted for that ratio are those seen by at least
-  // this many keyframes (ORB-SLAM2: 3; 2 while the map has two keyframes; monocular keeps 3). With 3, a
+  // RGB-D / stereo with keyframe_reference_min_found = 0 (the default counts frames, below): the reference
+  // keyframe's points counted for that ratio are those seen by at least this many keyframes (ORB-SLAM2:
+  // 3; 2 while the map has two keyframes; monocular keeps 3). With 3, a
   // threaded run whose keyframes thin out counts ever fewer points (they need three keyframes to count, and
   // the mapper culls points seen by fewer than three after two keyframes), so keyframes thin out further:
   // on the synthetic rooms 24-26 keyframes in 300 frames against 110-136 sequential, at 3x the ATE
@@ -91,11 +92,11 @@ struct TrackResult {
   std::shared_ptr<map::KeyFrame> reference_keyframe;
   bool new_keyframe = false;
   bool map_reset = false;
-  int tracked_points = 0;   // inliers after local-map tracking
+  int tracked_points = 0;  // inliers after local-map tracking
   int keypoints = 0;
   const char* method = "";  // "init", "motion", "reference", "relocalization", "motion+boxes", "lost"
   int box_matches = 0;      // keypoints in person boxes among the tracked points (BoxKeypoints)
-  int static_boxes = 0;     // boxes whose keypoints the static map vouched for (released, see box_keypoints.cpp)
+  int static_boxes = 0;  // boxes whose keypoints the static map vouched for (released, see box_keypoints.cpp)
   // The filtered frame failed and the keypoints in boxes tracked it (method "motion+boxes").
   bool rescued_with_boxes = false;
   double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
@@ -137,7 +138,9 @@ class Tracker {
   void set_keyframe_database(const loop::KeyframeDatabase* database) { database_ = database; }
   // Vocabulary for bags of words computed on demand (see frame_bow.h): for keyframes, reference-keyframe
   // tracking and relocalisation. Without it only frames built with a bag of words use one.
-  void set_vocabulary(std::shared_ptr<const bow::Vocabulary> vocabulary) { vocabulary_ = std::move(vocabulary); }
+  void set_vocabulary(std::shared_ptr<const bow::Vocabulary> vocabulary) {
+    vocabulary_ = std::move(vocabulary);
+  }
 
   // A map was loaded into the (so far empty) map: the next frame relocalises against it instead of
   // initialising, and the loaded map is never reset. With `localization_only` no keyframe is created
@@ -151,11 +154,11 @@ class Tracker {
 
  private:
   bool initialize(map::Frame& frame);
-  bool initialize_monocular(map::Frame& frame);                   // tracker_monocular.cpp
+  bool initialize_monocular(map::Frame& frame);  // tracker_monocular.cpp
   // After a monocular initialisation from `init_frame`: the earlier frames in frames_before_init_ that
   // the new map localises (tracker_monocular.cpp).
   std::vector<std::pair<uint64_t, geometry::SE3>> localize_frames_before_init(const map::Frame& init_frame,
-                                                                             uint64_t reference_id);
+                                                                              uint64_t reference_id);
   enum class KeyframeDecision { kNo, kInsert, kWaitForMapper };
   KeyframeDecision need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);
@@ -174,8 +177,8 @@ class Tracker {
                                                        size_t keyframe_index) const;
   int count_tracked_in_map(const map::Frame& frame) const;
   // The frame with its keypoints in boxes back (see track); nullopt when they do not help.
-  std::optional<map::Frame> with_box_keypoints(const map::Frame& frame, bool tracked, const BoxKeypoints& boxes,
-                                               int& static_boxes);
+  std::optional<map::Frame> with_box_keypoints(const map::Frame& frame, bool tracked,
+                                               const BoxKeypoints& boxes, int& static_boxes);
   // The last frame with its box keypoints (depth only), and the evidence its box keypoints give about this
   // frame's: matched where the pose says (+1) or not (-1). See box_keypoints.cpp.
   void remember_box_frame(const map::Frame& full);
@@ -205,7 +208,7 @@ class Tracker {
   bool map_loaded_ = false;
   bool localization_only_ = false;
   std::vector<std::shared_ptr<map::MapPoint>> temporal_points_;  // visual-odometry points of the last frame
-  std::optional<map::Frame> last_box_frame_;  // remember_box_frame
+  std::optional<map::Frame> last_box_frame_;                     // remember_box_frame
   std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
   std::vector<std::shared_ptr<map::MapPoint>> local_points_;
   // Monocular: the frames the initializer saw so far (localize_frames_before_init), oldest first.
