@@ -82,13 +82,32 @@ TEST(BoxDepth, APersonInFrontOfTheWallStandsOut) {
   EXPECT_EQ(box_depth_test(depth, kFactor, box, 0.5).verdict, BoxDepthVerdict::kFlat);
 }
 
-TEST(BoxDepth, ABoxFillingTheImageWidthIsUndecided) {
-  cv::Mat depth = plane_image(kFrontal, 3.0);
-  // Touches the left, right and top edges: no surroundings on two sides.
-  EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 0, 640, 400), 0.2).verdict,
-            BoxDepthVerdict::kUnknown);
-  // Only the right side and the top are seen: two sides, decided.
-  EXPECT_EQ(box_depth_test(depth, kFactor, cv::Rect2f(0, 50, 400, 400), 0.2).verdict, BoxDepthVerdict::kFlat);
+TEST(BoxDepth, ABoxFillingTheImageWidthIsJudgedOnStripsInsideItsEdges) {
+  // Touches the left, right and top edges: no surroundings on two sides, so the strips just inside the
+  // box's left and right edges (15 % of its width each) stand in for them.
+  cv::Mat wall = plane_image(kOblique, 1.5);
+  const cv::Rect2f full_width(0, 0, 640, 400);
+  const auto on_wall = box_depth_test(wall, kFactor, full_width, 0.2);
+  EXPECT_EQ(on_wall.verdict, BoxDepthVerdict::kFlat);
+  EXPECT_NEAR(on_wall.surface_m, on_wall.torso_m, 0.05 * on_wall.torso_m);
+  // A person close to the camera, the body over the middle 60 % of the width, 0.5 m in front of the wall.
+  cv::Mat person = wall.clone();
+  add_slab(person, cv::Rect(128, 0, 384, 400), 0.5);
+  const auto close_person = box_depth_test(person, kFactor, full_width, 0.2);
+  EXPECT_EQ(close_person.verdict, BoxDepthVerdict::kStandsOut);
+  EXPECT_GT(close_person.surface_m - close_person.torso_m, 0.4);
+  // A body that fills the whole box leaves nothing to compare with but itself: flat (the cost: such a
+  // person is not filtered, and left to the geometric check).
+  cv::Mat filled = wall.clone();
+  add_slab(filled, cv::Rect(0, 0, 640, 400), 0.5);
+  EXPECT_EQ(box_depth_test(filled, kFactor, full_width, 0.2).verdict, BoxDepthVerdict::kFlat);
+  // Only the right side and the top are seen: two sides outside, decided as before.
+  EXPECT_EQ(box_depth_test(plane_image(kFrontal, 3.0), kFactor, cv::Rect2f(0, 50, 400, 400), 0.2).verdict,
+            BoxDepthVerdict::kFlat);
+  // Without depth in the strips either: undecided.
+  cv::Mat holes = wall.clone();
+  holes(cv::Rect(0, 0, 96, 480)).setTo(0);
+  EXPECT_EQ(box_depth_test(holes, kFactor, full_width, 0.2).verdict, BoxDepthVerdict::kUnknown);
 }
 
 TEST(BoxDepth, NoDepthIsUndecided) {

@@ -115,6 +115,36 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
     if (!decided || *surface > test.surface_m) test.surface_m = *surface;
     decided = true;
   }
+  const bool at_side_edge =
+      box.x <= 1.0F || box.x + box.width >= static_cast<float>(depth_image_raw.cols) - 1.0F;
+  if (!decided && at_side_edge) {
+    // The box reaches the image's left or right edge and fewer than two sides outside it have depth (a
+    // false positive filling the image's width, session 13): strips just inside its left and right edges
+    // stand in for them. Beside a standing person those strips are mostly background (the box spans the
+    // arms and legs, the torso sits in the middle); on a wall they are wall. Holes in the depth image
+    // around a box inside the image still leave it undecided.
+    const Patch inner[2][3] = {{patch(depth_image_raw, depth_factor, box, 0.0, 0.0, 0.15, 0.33),
+                                patch(depth_image_raw, depth_factor, box, 0.0, 0.33, 0.15, 0.67),
+                                patch(depth_image_raw, depth_factor, box, 0.0, 0.67, 0.15, 1.0)},
+                               {patch(depth_image_raw, depth_factor, box, 0.85, 0.0, 1.0, 0.33),
+                                patch(depth_image_raw, depth_factor, box, 0.85, 0.33, 1.0, 0.67),
+                                patch(depth_image_raw, depth_factor, box, 0.85, 0.67, 1.0, 1.0)}};
+    std::vector<const Patch*> around;
+    int sides_used = 0;
+    for (const auto& strip : inner) {
+      int before = static_cast<int>(around.size());
+      for (const Patch& p : strip) {
+        if (p.depth_m > 0) around.push_back(&p);
+      }
+      if (static_cast<int>(around.size()) > before) ++sides_used;
+    }
+    if (sides_used == 2) {
+      if (const auto surface = gap_from(around)) {
+        test.surface_m = *surface;
+        decided = true;
+      }
+    }
+  }
   if (!decided) return test;
   test.verdict =
       test.surface_m - test.torso_m > margin_m ? BoxDepthVerdict::kStandsOut : BoxDepthVerdict::kFlat;
