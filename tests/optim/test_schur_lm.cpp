@@ -43,6 +43,17 @@ Problem to_problem(const PinholeCamera& camera, const BaScene& scene,
   return problem;
 }
 
+// Exact observations (no pixel noise, no outliers) of a scene whose start is perturbed as usual.
+BaSceneSpec noise_free_spec(int keyframes, int points, int fixed) {
+  BaSceneSpec spec;
+  spec.num_keyframes = keyframes;
+  spec.num_points = points;
+  spec.num_fixed = fixed;
+  spec.num_outliers = 0;
+  spec.pixel_noise = 0.0;
+  return spec;
+}
+
 }  // namespace
 
 TEST(SchurLm, InitialCostIsHalfTheHuberSumInClosedForm) {
@@ -78,11 +89,7 @@ TEST(SchurLm, InitialCostIsHalfTheHuberSumInClosedForm) {
 
 TEST(SchurLm, NoiseFreeProblemConvergesToTheTruth) {
   const PinholeCamera camera = test_camera();
-  BaSceneSpec spec;
-  spec.num_keyframes = 6;
-  spec.num_points = 200;
-  spec.num_outliers = 0;
-  spec.pixel_noise = 0.0;
+  BaSceneSpec spec = noise_free_spec(6, 200, 2);
   spec.seed = 7;
   const BaScene scene = make_ba_scene(camera, spec);
   Problem problem = to_problem(camera, scene, scene.keyframes, scene.points);
@@ -114,12 +121,7 @@ TEST(SchurLm, NoiseFreeProblemConvergesToTheTruth) {
 
 TEST(SchurLm, PointsAloneAreOptimisedWhenEveryPoseIsFixed) {
   const PinholeCamera camera = test_camera();
-  BaSceneSpec spec;
-  spec.num_keyframes = 4;
-  spec.num_points = 60;
-  spec.num_fixed = 4;
-  spec.num_outliers = 0;
-  spec.pixel_noise = 0.0;
+  const BaSceneSpec spec = noise_free_spec(4, 60, 4);
   const BaScene scene = make_ba_scene(camera, spec);
   Problem problem = to_problem(camera, scene, scene.keyframes, scene.points);
   const SchurLmSummary summary =
