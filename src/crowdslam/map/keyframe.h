@@ -105,8 +105,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::map<uint64_t, std::pair<std::weak_ptr<KeyFrame>, int>> connections_;
   std::vector<std::pair<int, std::weak_ptr<KeyFrame>>> ordered_connections_;  // weight desc
   bool first_connection_ = true;
-  std::shared_ptr<KeyFrame>
-      parent_;  // strong: a bad keyframe keeps its chain to the tree (trajectory output)
+  // Strong: a bad keyframe keeps its chain to the tree (trajectory output).
+  std::shared_ptr<KeyFrame> parent_;
   std::map<uint64_t, std::weak_ptr<KeyFrame>> children_;
   std::map<uint64_t, std::weak_ptr<KeyFrame>> loop_edges_;
   bool not_erase_ = false;

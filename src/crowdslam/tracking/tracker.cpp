@@ -498,13 +498,13 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe(const map::Frame& frame) co
       num_keyframes > max_frames) {
     return KeyframeDecision::kNo;
   }
-  const int min_observations = num_keyframes <= 2 ? 2 : options_.keyframe_reference_min_observations;
+  // The reference keyframe's points that count: found by tracking in enough frames (default), or seen by
+  // enough keyframes (keyframe_reference_min_found = 0).
   const int min_found = options_.keyframe_reference_min_found;
-  int reference_matches = 0;
-  if (reference_keyframe_) {
-    reference_matches = min_found > 0 ? reference_keyframe_->found_map_points(min_found)
-                                      : reference_keyframe_->tracked_map_points(min_observations);
-  }
+  const int min_observations = num_keyframes <= 2 ? 2 : options_.keyframe_reference_min_observations;
+  const int reference_matches = !reference_keyframe_ ? 0
+                                : min_found > 0      ? reference_keyframe_->found_map_points(min_found)
+                                                : reference_keyframe_->tracked_map_points(min_observations);
   const bool mapper_idle = mapper_->accepts_keyframes();
 
   // Close points (reliable depth) tracked vs. not tracked.
