@@ -110,6 +110,32 @@ TEST(BoxDepth, ABoxFillingTheImageWidthIsJudgedOnStripsInsideItsEdges) {
   EXPECT_EQ(box_depth_test(holes, kFactor, full_width, 0.2).verdict, BoxDepthVerdict::kUnknown);
 }
 
+TEST(BoxDepth, ANarrowBoxAtTheLeftEdgeIsJudgedOnStripsWideEnoughToHoldDepth) {
+  // Stereo near the left edge: no ORB keypoints within ~20 px and no right-image match closer than the
+  // disparity, so the first 40 columns hold no depth. A box 194 px wide from the image's (or nearly the
+  // image's) left edge, full height: no surroundings left, above or below; 15 % of its width (29 px)
+  // would be a strip of holes, the strip is 64 px instead.
+  cv::Mat wall = plane_image(kOblique, 1.5);
+  wall(cv::Rect(0, 0, 40, kHeight)).setTo(0);
+  for (const float x : {0.0F, 12.0F}) {
+    const cv::Rect2f box(x, 0, 194, 480);
+    const auto on_wall = box_depth_test(wall, kFactor, box, 0.2);
+    EXPECT_EQ(on_wall.verdict, BoxDepthVerdict::kFlat) << "box at x " << x;
+    // Here the oblique wall is 4-8 m deep and its depth doubles across the box: medians of depth over
+    // the patches are not the depth at their centres, so the plane is within 10 %, not exact.
+    EXPECT_NEAR(on_wall.surface_m, on_wall.torso_m, 0.1 * on_wall.torso_m);
+    // A person in the box's middle, 0.5 m in front of the wall: stands out.
+    cv::Mat person = wall.clone();
+    add_slab(person, cv::Rect(static_cast<int>(x) + 70, 0, 60, 480), 0.5);
+    EXPECT_EQ(box_depth_test(person, kFactor, box, 0.2).verdict, BoxDepthVerdict::kStandsOut) << "box at x " << x;
+  }
+  // A box well inside the image with holes around it is still undecided.
+  cv::Mat holes = plane_image(kOblique, 1.5);
+  holes(cv::Rect(100, 0, 60, kHeight)).setTo(0);
+  holes(cv::Rect(0, 0, kWidth, 40)).setTo(0);
+  EXPECT_EQ(box_depth_test(holes, kFactor, cv::Rect2f(160, 0, 200, 480), 0.2).verdict, BoxDepthVerdict::kUnknown);
+}
+
 TEST(BoxDepth, NoDepthIsUndecided) {
   const cv::Mat empty;
   EXPECT_EQ(box_depth_test(empty, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict,

@@ -89,5 +89,34 @@ TEST(SuppressNonMaxima, KeepsBestOfOverlappingAndDisjointBoxes) {
   EXPECT_EQ(suppress_non_maxima(boxes, 0.2, 0.95).size(), 3u);
 }
 
+TEST(RawBoxesNearLeaders, DropsRawBoxesFarLargerThanTheirNmsBox) {
+  // A 640x480 frame: a person's box (120x300) and a box spanning the whole frame, which the person's box
+  // suppresses at the paper's NMS 0.1 (IoU 36000 / 307200 = 0.117).
+  const PersonBox person{{260, 100, 120, 300}, 0.9f};
+  const PersonBox shifted{{270, 110, 120, 300}, 0.6f};  // a neighbour of the person's box: area ratio 1
+  const PersonBox tall{{250, 60, 130, 380}, 0.5f};      // ratio 49400 / 36000 = 1.37
+  const PersonBox frame{{0, 0, 640, 480}, 0.3f};        // ratio 8.5
+  const PersonBox other{{10, 10, 50, 60}, 0.4f};        // another person, its own NMS box
+  Detections d;
+  d.raw = {person, shifted, tall, frame, other};
+  d.boxes = suppress_non_maxima(d.raw, 0.2, 0.1);
+  ASSERT_EQ(d.boxes.size(), 2u);  // the frame-wide box was suppressed by the person's
+  int dropped = -1;
+  const auto kept = raw_boxes_near_leaders(d, 2.0, &dropped);
+  EXPECT_EQ(dropped, 1);
+  ASSERT_EQ(kept.size(), 4u);
+  for (const auto& b : kept) EXPECT_NE(b.box, frame.box);
+  // At ratio 1.3 the tall box (1.37) goes too; at 10 and at 0 (off) every raw box stays.
+  EXPECT_EQ(raw_boxes_near_leaders(d, 1.3, &dropped).size(), 3u);
+  EXPECT_EQ(dropped, 2);
+  EXPECT_EQ(raw_boxes_near_leaders(d, 10.0, &dropped).size(), 5u);
+  EXPECT_EQ(raw_boxes_near_leaders(d, 0.0, &dropped).size(), 5u);
+  EXPECT_EQ(dropped, 0);
+  // A raw box that overlaps no NMS box has no person to outline: dropped.
+  d.raw.push_back({{600, 400, 20, 20}, 0.25f});
+  EXPECT_EQ(raw_boxes_near_leaders(d, 2.0, &dropped).size(), 4u);
+  EXPECT_EQ(dropped, 2);
+}
+
 }  // namespace
 }  // namespace crowdslam::people

@@ -77,6 +77,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("Detector.nms"), s.detector.nms);
   set_if(r.integer("Detector.person_class"), s.detector.person_class);
   set_if(r.flag("Detector.filter_before_nms"), s.detector.filter_before_nms);
+  set_if(r.real("Detector.raw_box_max_area_ratio"), s.detector.raw_box_max_area_ratio);
   set_if(r.text("Detector.mode"), s.detector.mode);
   set_if(r.flag("Detector.tracker"), s.detector.tracker);
   set_if(r.real("Detector.track_iou"), s.detector.track_iou);
@@ -178,7 +179,8 @@ bool operator==(const Settings& a, const Settings& b) {
                         da.preprocess == db.preprocess && da.resize == db.resize &&
                         da.confidence == db.confidence &&
                         da.nms == db.nms && da.person_class == db.person_class &&
-                        da.filter_before_nms == db.filter_before_nms;
+                        da.filter_before_nms == db.filter_before_nms &&
+                        da.raw_box_max_area_ratio == db.raw_box_max_area_ratio;
   const bool people = a.people_filter.enabled == b.people_filter.enabled &&
                       a.people_filter.mode == b.people_filter.mode &&
                       a.people_filter.margin_px == b.people_filter.margin_px &&

@@ -71,6 +71,9 @@ struct DetectorSettings {
   double nms = 0.1;
   int person_class = 0;
   bool filter_before_nms = true;
+  // Raw boxes over this many times the area of their NMS box are not used as masks (0 = all raw boxes,
+  // as the paper); see people::raw_boxes_near_leaders.
+  double raw_box_max_area_ratio = 2.0;
   // "every_frame": detect on every frame, the frame waits for its boxes; "latest": the detector takes the
   // newest frame when free, other frames get its boxes moved by the image flow (system/people_stage.h).
   std::string mode = "every_frame";
@@ -96,7 +99,7 @@ struct PeopleFilterSettings {
   // box_keypoints.cpp): a false-positive box over most of the image, or background a person box hides,
   // then costs no tracking. Nothing in the map is made of them.
   // "monocular" (default): with --sensor mono only, where a box hides the background behind a person
-  // (no depth mode to keep it); "always"; "never". Measured in docs/DETECTION.md.
+  // (no depth mode to keep it); "always"; "never". Measured in docs/CROWDS.md.
   std::string static_in_boxes = "monocular";
   int static_check_below = 150;
   // RGB-D: a box whose torso region is not closer than the surface around the box by more than this is

@@ -50,6 +50,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Detector.nms",
                                   "Detector.person_class",
                                   "Detector.filter_before_nms",
+                                  "Detector.raw_box_max_area_ratio",
                                   "Detector.mode",
                                   "Detector.tracker",
                                   "Detector.track_iou",

@@ -10,6 +10,8 @@ namespace crowdslam::people {
 
 namespace {
 
+constexpr double kMinStripPx = 64.0;  // inner strips of a box at the image's edge (box_depth_test)
+
 struct Patch {
   double u = 0;
   double v = 0;
@@ -115,20 +117,26 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
     if (!decided || *surface > test.surface_m) test.surface_m = *surface;
     decided = true;
   }
+  // Near the edge: too little room outside the box for a patch with keypoints in it.
+  const auto near = static_cast<float>(kMinStripPx);
   const bool at_side_edge =
-      box.x <= 1.0F || box.x + box.width >= static_cast<float>(depth_image_raw.cols) - 1.0F;
+      box.x < near || box.x + box.width > static_cast<float>(depth_image_raw.cols) - near;
   if (!decided && at_side_edge) {
     // The box reaches the image's left or right edge and fewer than two sides outside it have depth (a
     // false positive filling the image's width, session 13): strips just inside its left and right edges
     // stand in for them. Beside a standing person those strips are mostly background (the box spans the
     // arms and legs, the torso sits in the middle); on a wall they are wall. Holes in the depth image
     // around a box inside the image still leave it undecided.
-    const Patch inner[2][3] = {{patch(depth_image_raw, depth_factor, box, 0.0, 0.0, 0.15, 0.33),
-                                patch(depth_image_raw, depth_factor, box, 0.0, 0.33, 0.15, 0.67),
-                                patch(depth_image_raw, depth_factor, box, 0.0, 0.67, 0.15, 1.0)},
-                               {patch(depth_image_raw, depth_factor, box, 0.85, 0.0, 1.0, 0.33),
-                                patch(depth_image_raw, depth_factor, box, 0.85, 0.33, 1.0, 0.67),
-                                patch(depth_image_raw, depth_factor, box, 0.85, 0.67, 1.0, 1.0)}};
+    // Each strip 15 % of the box's width, at least kMinStripPx (a third of the box at most): at the
+    // image's edge there are no ORB keypoints within ~20 px, and stereo has no match closer to the left
+    // edge than the disparity, so a narrow strip there holds no depth even on a wall.
+    const double w = std::min(1.0 / 3.0, std::max(0.15, kMinStripPx / box.width));
+    const Patch inner[2][3] = {{patch(depth_image_raw, depth_factor, box, 0.0, 0.0, w, 0.33),
+                                patch(depth_image_raw, depth_factor, box, 0.0, 0.33, w, 0.67),
+                                patch(depth_image_raw, depth_factor, box, 0.0, 0.67, w, 1.0)},
+                               {patch(depth_image_raw, depth_factor, box, 1.0 - w, 0.0, 1.0, 0.33),
+                                patch(depth_image_raw, depth_factor, box, 1.0 - w, 0.33, 1.0, 0.67),
+                                patch(depth_image_raw, depth_factor, box, 1.0 - w, 0.67, 1.0, 1.0)}};
     std::vector<const Patch*> around;
     int sides_used = 0;
     for (const auto& strip : inner) {

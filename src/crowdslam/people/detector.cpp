@@ -110,4 +110,29 @@ std::vector<PersonBox> suppress_non_maxima(const std::vector<PersonBox>& boxes, 
   return kept;
 }
 
+std::vector<PersonBox> raw_boxes_near_leaders(const Detections& detections, double max_area_ratio,
+                                              int* dropped) {
+  if (dropped != nullptr) *dropped = 0;
+  if (!(max_area_ratio > 0)) return detections.raw;
+  std::vector<PersonBox> kept;
+  kept.reserve(detections.raw.size());
+  for (const PersonBox& r : detections.raw) {
+    double best = 0.0;
+    double leader_area = 0.0;
+    for (const PersonBox& b : detections.boxes) {
+      const double iou = box_iou(r.box, b.box);
+      if (iou > best) {
+        best = iou;
+        leader_area = b.box.area();
+      }
+    }
+    if (best > 0 && r.box.area() <= max_area_ratio * leader_area) {
+      kept.push_back(r);
+    } else if (dropped != nullptr) {
+      ++*dropped;
+    }
+  }
+  return kept;
+}
+
 }  // namespace crowdslam::people

@@ -86,4 +86,12 @@ double box_iou(const cv::Rect2f& a, const cv::Rect2f& b);
 std::vector<PersonBox> suppress_non_maxima(const std::vector<PersonBox>& boxes, double confidence,
                                            double nms);
 
+// The raw (before-NMS) boxes that outline the person of an NMS box: each raw box's leader is the NMS box
+// it overlaps most (by IoU); a raw box more than `max_area_ratio` times its leader's area (or overlapping
+// no NMS box) is dropped and counted in `*dropped`. A low NMS threshold (the paper's 0.1) lets a box
+// spanning most of the image be suppressed by a person's box; as a mask it would hide the whole scene.
+// max_area_ratio <= 0 keeps every raw box.
+std::vector<PersonBox> raw_boxes_near_leaders(const Detections& detections, double max_area_ratio,
+                                              int* dropped = nullptr);
+
 }  // namespace crowdslam::people

@@ -240,6 +240,8 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                               {"mode", s.people_filter.mode},
                                               {"margin_px", s.people_filter.margin_px},
                                               {"filter_before_nms", s.detector.filter_before_nms},
+                                              {"raw_box_max_area_ratio", s.detector.raw_box_max_area_ratio},
+                                              {"raw_boxes_dropped", people->stats().raw_boxes_dropped},
                                               {"static_in_boxes", s.people_filter.static_in_boxes},
                                               {"static_check_below", s.people_filter.static_check_below},
                                               {"frames_with_box_matches", frames_with_box_matches},

@@ -76,6 +76,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   right_image_boxes_ = settings.people_filter.right_image == "boxes";
   flat_box_margin_m_ = settings.people_filter.flat_box_margin_m;
   filter_before_nms_ = settings.detector.filter_before_nms;
+  raw_box_max_area_ratio_ = settings.detector.raw_box_max_area_ratio;
   budget_options_.base_features = settings.orb.n_features;
   budget_options_.enabled = settings.feature_budget.enabled;
   budget_options_.thresholds = settings.feature_budget.thresholds;
@@ -207,8 +208,8 @@ void PeopleStage::take_detection(people::WorkerResult result, const people::Flow
   detection_frame_ = static_cast<int64_t>(result.frame_index);
   detection_ms_ = result.detections.time_ms;
   const bool use_raw = filter_before_nms_ && !tracker_;
-  const auto& source = use_raw ? result.detections.raw : result.detections.boxes;
-  std::vector<people::FlowBox> detected = people::to_flow_boxes(source);
+  std::vector<people::FlowBox> detected =
+      people::to_flow_boxes(use_raw ? masking_raw_boxes(result.detections) : result.detections.boxes);
   std::vector<bool> nms(detected.size(), true);
   if (use_raw) {
     for (size_t i = 0; i < detected.size(); ++i) {
@@ -263,6 +264,13 @@ void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv
   }
 }
 
+std::vector<people::PersonBox> PeopleStage::masking_raw_boxes(const people::Detections& detections) {
+  int dropped = 0;
+  std::vector<people::PersonBox> raw = people::raw_boxes_near_leaders(detections, raw_box_max_area_ratio_, &dropped);
+  stats_.raw_boxes_dropped += static_cast<std::size_t>(dropped);
+  return raw;
+}
+
 void PeopleStage::current_boxes(std::vector<people::PersonBox>& filter_boxes,
                                 std::vector<people::PersonBox>& area_boxes) const {
   filter_boxes.clear();
@@ -294,7 +302,7 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
       fresh_ = true;
       detection_frame_ = static_cast<int64_t>(index);
       detection_ms_ = result.detections.time_ms;
-      boxes = filter_before_nms_ ? result.detections.raw : result.detections.boxes;
+      boxes = filter_before_nms_ ? masking_raw_boxes(result.detections) : result.detections.boxes;
       area_boxes = result.detections.boxes;
     }
   } else {

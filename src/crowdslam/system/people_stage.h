@@ -68,6 +68,7 @@ struct PeopleStageStats {
   std::size_t tracks_coasting = 0;    // summed over detections: confirmed tracks kept without a match
   std::size_t flat_boxes = 0;         // boxes the depth test found flat (summed over frames, NMS level)
   std::size_t frames_with_flat_boxes = 0;
+  std::size_t raw_boxes_dropped = 0;  // raw boxes far larger than their NMS box, not used as masks
 };
 
 class PeopleStage {
@@ -95,6 +96,8 @@ class PeopleStage {
   void take_detection(people::WorkerResult result, const people::FlowImage& image);
   // Boxes the filter uses now, and the ones (NMS level) that say how much of the image people cover.
   void current_boxes(std::vector<people::PersonBox>& filter_boxes, std::vector<people::PersonBox>& area_boxes) const;
+  // The raw boxes used as masks (Detector.raw_box_max_area_ratio); counts the ones left out.
+  std::vector<people::PersonBox> masking_raw_boxes(const people::Detections& detections);
   void move_to(const people::FlowImage& image);
   void flow(const people::FlowImage& from, const people::FlowImage& to, std::vector<people::FlowBox>& boxes,
             std::vector<bool>* nms, std::vector<int>* leader);
@@ -109,6 +112,7 @@ class PeopleStage {
   people::BoxFlowOptions flow_options_;
   std::optional<people::BoxTracker> tracker_;
   bool filter_before_nms_ = true;
+  double raw_box_max_area_ratio_ = 0.0;
   bool right_image_boxes_ = false;
   double flat_box_margin_m_ = 0;
   int next_feature_budget_ = 0;
