@@ -74,6 +74,9 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("--detector-mode", args->options.detector_mode,
                   "every_frame: each frame waits for its own boxes; latest: the detector takes the newest frame "
                   "when free and other frames get its boxes moved by the image flow (Detector.mode)");
+  cmd->add_option("--detector-interval", args->options.detector_interval,
+                  "latest mode: offer the detector a frame at most every N frames (1 = whenever it is free; "
+                  "Detector.latest_interval)");
   cmd->add_option("--box-tracker", args->options.box_tracker,
                   "on: boxes persist through missed detections and one-detection boxes are dropped (Detector.tracker)");
   cmd->add_option("--geometry", args->options.geometry,

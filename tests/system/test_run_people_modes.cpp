@@ -65,6 +65,41 @@ TEST(RunPeopleModes, LatestModePropagatesEveryFrameAndStillTracksTheCrowd) {
   EXPECT_GT(removed_in_propagated, 0);  // the moved boxes still filter
 }
 
+TEST(RunPeopleModes, LatestIntervalSpacesTheDetectionsAndTheFlowFillsTheFramesBetween) {
+  test::TempDir tmp;
+  const auto dataset = make_crowd(tmp, 90);
+  run::RunOptions options;
+  options.dataset = dataset.string();
+  options.out_dir = (tmp / "every4").string();
+  options.sequential = true;
+  options.progress = false;
+  options.detections_file = (dataset / "people_gt.txt").string();
+  options.detector_mode = "latest";
+  options.detector_interval = 4;
+  const auto summary = run::run_sequence(options);
+  EXPECT_EQ(summary.tracked, 90u);
+  EXPECT_EQ(summary.json["people_filter"]["latest_interval"].get<int>(), 4);
+  std::set<int64_t> detected;
+  for (const auto& f : summary.json["frames"]) {
+    const auto d = f["detection_frame"].get<int64_t>();
+    if (d >= 0) detected.insert(d);
+  }
+  // Frames offered at least 4 apart: at most 23 of 90 frames detected, and at least every 4-8 frames one
+  // (a frame is offered when it is due and the detector free; the file detector is never busy for long).
+  ASSERT_GE(detected.size(), 10u);
+  EXPECT_LE(detected.size(), 23u);
+  for (auto it = std::next(detected.begin()); it != detected.end(); ++it) EXPECT_GE(*it - *std::prev(it), 4);
+  // A bad value names the option.
+  options.out_dir = (tmp / "bad").string();
+  options.detector_interval = -2;
+  try {
+    run::run_sequence(options);
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("--detector-interval"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RunPeopleModes, TrackerModeUsesConfirmedTracksOnly) {
   test::TempDir tmp;
   const auto dataset = make_crowd(tmp, 60);

@@ -79,6 +79,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.flag("Detector.filter_before_nms"), s.detector.filter_before_nms);
   set_if(r.real("Detector.raw_box_max_area_ratio"), s.detector.raw_box_max_area_ratio);
   set_if(r.text("Detector.mode"), s.detector.mode);
+  set_if(r.integer("Detector.latest_interval"), s.detector.latest_interval);
   set_if(r.flag("Detector.tracker"), s.detector.tracker);
   set_if(r.real("Detector.track_iou"), s.detector.track_iou);
   set_if(r.integer("Detector.track_min_hits"), s.detector.track_min_hits);

@@ -77,6 +77,9 @@ struct DetectorSettings {
   // "every_frame": detect on every frame, the frame waits for its boxes; "latest": the detector takes the
   // newest frame when free, other frames get its boxes moved by the image flow (system/people_stage.h).
   std::string mode = "every_frame";
+  // latest mode: a frame is offered to the detector only this many frames after the last one it took
+  // (1 = whenever it is free); between detections the boxes move with the image flow.
+  int latest_interval = 1;
   // Short-term box tracks (people/box_tracker.h) and their parameters.
   bool tracker = false;
   double track_iou = 0.3;

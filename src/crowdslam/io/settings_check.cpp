@@ -169,6 +169,7 @@ void check_detector(const Checker& c, const DetectorSettings& d) {
   c.require(std::isfinite(d.confidence) && d.confidence > 0 && d.confidence <= 1, "Detector.confidence",
             "in (0, 1]", d.confidence);
   c.require(std::isfinite(d.nms) && d.nms > 0 && d.nms <= 1, "Detector.nms", "in (0, 1]", d.nms);
+  c.require(d.latest_interval >= 1, "Detector.latest_interval", ">= 1", d.latest_interval);
   c.require(std::isfinite(d.raw_box_max_area_ratio) && (d.raw_box_max_area_ratio == 0 || d.raw_box_max_area_ratio >= 1),
             "Detector.raw_box_max_area_ratio", "0 (off) or >= 1", d.raw_box_max_area_ratio);
   c.require(d.person_class >= 0, "Detector.person_class", ">= 0", d.person_class);

@@ -52,6 +52,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Detector.filter_before_nms",
                                   "Detector.raw_box_max_area_ratio",
                                   "Detector.mode",
+                                  "Detector.latest_interval",
                                   "Detector.tracker",
                                   "Detector.track_iou",
                                   "Detector.track_min_hits",

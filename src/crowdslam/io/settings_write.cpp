@@ -97,6 +97,7 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nDetector.person_class: " << d.person_class
       << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0)
       << "\nDetector.raw_box_max_area_ratio: " << real_text(d.raw_box_max_area_ratio) << "\nDetector.mode: " << quoted(d.mode)
+      << "\nDetector.latest_interval: " << d.latest_interval
       << "\nDetector.tracker: " << (d.tracker ? 1 : 0) << "\nDetector.track_iou: " << real_text(d.track_iou)
       << "\nDetector.track_min_hits: " << d.track_min_hits << "\nDetector.track_max_misses: " << d.track_max_misses
       << "\nDetector.track_confirm_confidence: " << real_text(d.track_confirm_confidence) << "\n\n";

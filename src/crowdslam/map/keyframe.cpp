@@ -253,10 +253,7 @@ std::vector<std::shared_ptr<KeyFrame>> KeyFrame::loop_edges() const {
 }
 
 // ---- lifetime ----
-bool KeyFrame::is_bad() const {
-  std::lock_guard lock(connections_mutex_);
-  return bad_;
-}
+bool KeyFrame::is_bad() const { return bad_.load(std::memory_order_acquire); }
 
 void KeyFrame::set_not_erase() {
   std::lock_guard lock(connections_mutex_);

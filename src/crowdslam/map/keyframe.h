@@ -3,6 +3,7 @@
 // its pose, its map point associations, and its place in the covisibility graph and spanning tree.
 // Thread-safe: see docs/ARCHITECTURE.md "Locking" (pose, features and connections have separate mutexes;
 // no method calls into another object while holding its own lock).
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -111,7 +112,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::map<uint64_t, std::weak_ptr<KeyFrame>> loop_edges_;
   bool not_erase_ = false;
   bool to_be_erased_ = false;
-  bool bad_ = false;
+  std::atomic<bool> bad_{false};  // written under connections_mutex_; is_bad() reads it without the lock
   geometry::SE3 cam_from_parent_;
 };
 

@@ -184,15 +184,9 @@ void MapPoint::update_normal_and_depth() {
   normal_.normalize();
 }
 
-void MapPoint::increase_visible(int n) {
-  std::lock_guard lock(features_mutex_);
-  visible_ += n;
-}
+void MapPoint::increase_visible(int n) { visible_.fetch_add(n, std::memory_order_relaxed); }
 
-void MapPoint::increase_found(int n) {
-  std::lock_guard lock(features_mutex_);
-  found_ += n;
-}
+void MapPoint::increase_found(int n) { found_.fetch_add(n, std::memory_order_relaxed); }
 
 int MapPoint::record_motion(bool moving) {
   std::lock_guard lock(features_mutex_);
@@ -214,24 +208,15 @@ int MapPoint::motion_score() const {
 }
 
 float MapPoint::found_ratio() const {
-  std::lock_guard lock(features_mutex_);
-  return static_cast<float>(found_) / static_cast<float>(std::max(1, visible_));
+  return static_cast<float>(found_.load(std::memory_order_relaxed)) /
+         static_cast<float>(std::max(1, visible_.load(std::memory_order_relaxed)));
 }
 
-int MapPoint::visible_count() const {
-  std::lock_guard lock(features_mutex_);
-  return visible_;
-}
+int MapPoint::visible_count() const { return visible_.load(std::memory_order_relaxed); }
 
-int MapPoint::found_count() const {
-  std::lock_guard lock(features_mutex_);
-  return found_;
-}
+int MapPoint::found_count() const { return found_.load(std::memory_order_relaxed); }
 
-bool MapPoint::is_bad() const {
-  std::lock_guard lock(features_mutex_);
-  return bad_;
-}
+bool MapPoint::is_bad() const { return bad_.load(std::memory_order_acquire); }
 
 void MapPoint::set_bad() {
   std::map<uint64_t, Observation> obs;

@@ -2,6 +2,7 @@
 // A 3D landmark. Shared (std::shared_ptr) between the map, keyframes and the current frame; its links back
 // to keyframes are weak, so culling a keyframe frees it. Thread-safe: see docs/ARCHITECTURE.md "Locking".
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -104,10 +105,12 @@ class MapPoint {
   int num_observations_ = 0;
   std::weak_ptr<KeyFrame> reference_keyframe_;
   Descriptor descriptor_{};
-  int visible_ = 1;
-  int found_ = 1;
+  // Read on every tracked frame for every local point: atomics, not the mutex (bad_ is written under
+  // the mutex, with the observations it goes with).
+  std::atomic<int> visible_{1};
+  std::atomic<int> found_{1};
   uint8_t motion_bits_ = 0;  // the last kMotionWindow verdicts, newest in bit 0 (1 = moving)
-  bool bad_ = false;
+  std::atomic<bool> bad_{false};
   std::weak_ptr<MapPoint> replaced_by_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -127,16 +128,26 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
     // stand in for them. Beside a standing person those strips are mostly background (the box spans the
     // arms and legs, the torso sits in the middle); on a wall they are wall. Holes in the depth image
     // around a box inside the image still leave it undecided.
-    // Each strip 15 % of the box's width, at least kMinStripPx (a third of the box at most): at the
-    // image's edge there are no ORB keypoints within ~20 px, and stereo has no match closer to the left
-    // edge than the disparity, so a narrow strip there holds no depth even on a wall.
-    const double w = std::min(1.0 / 3.0, std::max(0.15, kMinStripPx / box.width));
-    const Patch inner[2][3] = {{patch(depth_image_raw, depth_factor, box, 0.0, 0.0, w, 0.33),
-                                patch(depth_image_raw, depth_factor, box, 0.0, 0.33, w, 0.67),
-                                patch(depth_image_raw, depth_factor, box, 0.0, 0.67, w, 1.0)},
-                               {patch(depth_image_raw, depth_factor, box, 1.0 - w, 0.0, 1.0, 0.33),
-                                patch(depth_image_raw, depth_factor, box, 1.0 - w, 0.33, 1.0, 0.67),
-                                patch(depth_image_raw, depth_factor, box, 1.0 - w, 0.67, 1.0, 1.0)}};
+    // Each strip 15 % of the box's width. A strip without depth is widened to kMinStripPx (a third of
+    // the box at most): in stereo there are no ORB keypoints within ~20 px of the image's edge and no
+    // right-image match closer to the left edge than the disparity, so a narrow strip there holds no
+    // depth even on a wall. (Wider strips everywhere judged people who fill a narrow box at the edge,
+    // entering the view, on themselves: flat.)
+    const double wide = std::min(1.0 / 3.0, std::max(0.15, kMinStripPx / box.width));
+    auto strip = [&](bool left, double w) {
+      std::array<Patch, 3> p;
+      const double x0 = left ? 0.0 : 1.0 - w;
+      const double y[4] = {0.0, 0.33, 0.67, 1.0};
+      for (int k = 0; k < 3; ++k) p[static_cast<size_t>(k)] = patch(depth_image_raw, depth_factor, box, x0, y[k], x0 + w, y[k + 1]);
+      return p;
+    };
+    auto has_depth = [](const std::array<Patch, 3>& p) {
+      return std::any_of(p.begin(), p.end(), [](const Patch& q) { return q.depth_m > 0; });
+    };
+    std::array<Patch, 3> inner[2] = {strip(true, 0.15), strip(false, 0.15)};
+    for (int side = 0; side < 2; ++side) {
+      if (!has_depth(inner[side]) && wide > 0.15) inner[side] = strip(side == 0, wide);
+    }
     std::vector<const Patch*> around;
     int sides_used = 0;
     for (const auto& strip : inner) {

@@ -227,6 +227,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   doc["people_filter"] = people != nullptr
                              ? nlohmann::json{{"detector", slam.detector_name()},
                                               {"detector_mode", system::to_string(people->mode())},
+                                              {"latest_interval", s.detector.latest_interval},
                                               {"box_tracker", people->tracker_enabled()},
                                               {"detections", people->stats().detections},
                                               {"frames_detected", people->stats().frames_detected},

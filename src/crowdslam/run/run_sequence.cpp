@@ -103,6 +103,13 @@ Prepared prepare(const RunOptions& options) {
     }
     p.run_settings.detector.mode = options.detector_mode;
   }
+  if (options.detector_interval != 0) {
+    if (options.detector_interval < 1) {
+      throw InputError("--detector-interval: expected a number of frames >= 1, got " +
+                       std::to_string(options.detector_interval));
+    }
+    p.run_settings.detector.latest_interval = options.detector_interval;
+  }
   if (!options.box_tracker.empty()) {
     if (options.box_tracker != "on" && options.box_tracker != "off") {
       throw InputError("--box-tracker: expected 'on' or 'off', got '" + clip_text(options.box_tracker, 60) + "'");

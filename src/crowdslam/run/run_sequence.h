@@ -45,6 +45,7 @@ struct RunOptions {
   std::string detector_model;       // --detector: body | coco | PATH.cfg | PATH.onnx
   std::string filter_mode;          // --filter-mode: overrides PeopleFilter.mode (paper | depth)
   std::string detector_mode;        // --detector-mode: overrides Detector.mode (every_frame | latest)
+  int detector_interval = 0;        // --detector-interval: overrides Detector.latest_interval (0 = keep)
   std::string box_tracker;          // --box-tracker: overrides Detector.tracker (on | off)
   std::string geometry;             // --geometry: overrides Geometry.dynamic_check (on | off)
   size_t save_frames = 0;           // --save-frames N: every N-th frame drawn into OUT/frames/

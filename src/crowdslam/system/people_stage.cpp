@@ -61,6 +61,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
       depth_map_factor_(settings.depth_map_factor > 0 ? settings.depth_map_factor : 1.0),
       worker_(std::make_unique<people::DetectionWorker>(make_detector(settings, options))) {
   mode_ = parse_detector_mode(settings.detector.mode, "Detector.mode");
+  latest_interval_ = static_cast<std::size_t>(std::max(1, settings.detector.latest_interval));
   if (settings.detector.tracker) {
     people::BoxTrackerOptions t;
     t.iou = settings.detector.track_iou;
@@ -258,9 +259,11 @@ void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv
   const people::FlowImage image = people::make_flow_image(gray, flow_options_);
   move_to(image);
   if (auto result = worker_->poll()) take_detection(std::move(*result), image);
-  if (worker_->offer(index, colour)) {
+  const bool due = !offered_any_ || index >= offered_index_ + latest_interval_;
+  if (due && worker_->offer(index, colour)) {
     offered_ = image;
     offered_index_ = index;
+    offered_any_ = true;
   }
 }
 

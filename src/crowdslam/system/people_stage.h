@@ -124,6 +124,8 @@ class PeopleStage {
   people::FlowImage current_;
   people::FlowImage offered_;      // the frame the detector is working on (latest mode)
   std::size_t offered_index_ = 0;
+  bool offered_any_ = false;
+  std::size_t latest_interval_ = 1;  // Detector.latest_interval
   int64_t detection_frame_ = -1;
   double detection_ms_ = 0;        // forward time of the detection taken this frame
   bool fresh_ = false;             // a detection was taken this frame
