@@ -112,11 +112,19 @@ Descriptor MapPoint::descriptor() const {
 void MapPoint::compute_distinctive_descriptor() {
   std::vector<const uint8_t*> descriptors;
   std::vector<std::shared_ptr<KeyFrame>> keep_alive;
-  for (const auto& [kf_id, obs] : observations()) {
-    auto kf = obs.keyframe.lock();
-    if (!kf || kf->is_bad()) continue;
-    descriptors.push_back(kf->features->descriptor(obs.index));
-    keep_alive.push_back(std::move(kf));
+  {
+    // Under the lock without copying the observations: KeyFrame::is_bad() takes no lock and a keyframe's
+    // features never change, so no other mutex is taken here.
+    std::lock_guard lock(features_mutex_);
+    descriptors.reserve(observations_.size());
+    keep_alive.reserve(observations_.size());
+    for (const auto& [kf_id, obs] : observations_) {
+      auto kf = obs.keyframe.lock();
+      if (!kf) continue;
+      const bool usable = !kf->is_bad();
+      if (usable) descriptors.push_back(kf->features->descriptor(obs.index));
+      keep_alive.push_back(std::move(kf));  // released after the lock, whatever its state
+    }
   }
   if (descriptors.empty()) return;
   const size_t n = descriptors.size();
@@ -152,21 +160,22 @@ void MapPoint::set_descriptor(const uint8_t* descriptor) {
 }
 
 void MapPoint::update_normal_and_depth() {
-  std::map<uint64_t, Observation> obs;
+  std::vector<std::shared_ptr<KeyFrame>> keyframes;  // a flat copy: no map nodes to allocate
   std::shared_ptr<KeyFrame> reference;
   {
     std::lock_guard lock(features_mutex_);
     if (bad_) return;
-    obs = observations_;
+    keyframes.reserve(observations_.size());
+    for (const auto& [kf_id, o] : observations_) {
+      if (auto kf = o.keyframe.lock()) keyframes.push_back(std::move(kf));
+    }
     reference = reference_keyframe_.lock();
   }
-  if (obs.empty() || !reference) return;
+  if (keyframes.empty() || !reference) return;
   const geometry::Vec3 position = world();
   geometry::Vec3 normal_sum = geometry::Vec3::Zero();
   int count = 0;
-  for (const auto& [kf_id, o] : obs) {
-    auto kf = o.keyframe.lock();
-    if (!kf) continue;
+  for (const auto& kf : keyframes) {
     normal_sum += (position - kf->camera_center()).normalized();
     ++count;
   }
