@@ -9,6 +9,7 @@
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
+#include "blank_frames.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -161,17 +162,7 @@ TEST(RunPeopleModes, LongLossStartsANewMapAndKeepsTheOldOne) {
   const auto dir = tmp / "blind";
   synth::write_sequence(options, dir);
   // Frames 40-79 black: no features, tracking lost for 40 frames (more than the 30 that start a new map).
-  int blanked = 0;
-  for (const auto& e : std::filesystem::directory_iterator(dir / "rgb")) {
-    const int index = std::stoi(e.path().stem().string());
-    if (index >= 40 && index < 80) {
-      cv::Mat image = cv::imread(e.path().string(), cv::IMREAD_COLOR);
-      image.setTo(cv::Scalar(0, 0, 0));
-      cv::imwrite(e.path().string(), image);
-      ++blanked;
-    }
-  }
-  ASSERT_EQ(blanked, 40);
+  ASSERT_EQ(test::blank_frames(dir / "rgb", 40, 80), 40);
   run::RunOptions run;
   run.dataset = dir.string();
   run.out_dir = (tmp / "out").string();

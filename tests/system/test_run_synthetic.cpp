@@ -1,11 +1,10 @@
 // End-to-end: SLAM on sequences from the synthetic generator, against their exact ground truth.
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
+#include "blank_frames.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -92,17 +91,7 @@ TEST(RunSynthetic, AfterRelocalisingTrackingGoesOnIntoWhatTheMapHasNotSeen) {
   options.seed = 1;
   const auto dir = tmp / "room";
   synth::write_sequence(options, dir);
-  int blanked = 0;
-  for (const auto& e : std::filesystem::directory_iterator(dir / "rgb")) {
-    const int index = std::stoi(e.path().stem().string());
-    if (index >= 200 && index < 203) {
-      cv::Mat image = cv::imread(e.path().string(), cv::IMREAD_COLOR);
-      image.setTo(cv::Scalar(0, 0, 0));
-      cv::imwrite(e.path().string(), image);
-      ++blanked;
-    }
-  }
-  ASSERT_EQ(blanked, 3);
+  ASSERT_EQ(test::blank_frames(dir / "rgb", 200, 203), 3);
   const auto summary = run_slam(dir, tmp / "out", false);
   EXPECT_EQ(summary.json["summary"]["map_resets"].get<int>(), 0);
   EXPECT_GE(summary.tracked, 256u);  // all but the black frames (and at most one more)
