@@ -23,7 +23,8 @@ void print_summary(const run::RunSummary& summary) {
             << "frames            " << summary.frames << "\n"
             << "tracked           " << summary.tracked << " (" << summary.tracked_percent << " %)\n"
             << "throughput        " << summary.throughput_fps << " frames/s\n"
-            << "tracking ms       median " << summary.tracking_ms_median << ", p95 " << summary.tracking_ms_p95 << "\n"
+            << "tracking ms       median " << summary.tracking_ms_median << ", p95 "
+            << summary.tracking_ms_p95 << "\n"
             << "extraction ms     median " << summary.extraction_ms_median << "\n";
   if (summary.init_frame) std::cout << "initialised at    frame " << *summary.init_frame << "\n";
   if (summary.segments.size() > 1) {
@@ -37,8 +38,8 @@ void print_summary(const run::RunSummary& summary) {
       for (const auto& a : summary.segment_accuracy) {
         if (a.map_id == *summary.evaluated_map_id) poses = a.poses;
       }
-      std::cout << " (map " << *summary.evaluated_map_id << ", the longest: " << poses << " of " << summary.tracked
-                << " poses; each map in run.json)";
+      std::cout << " (map " << *summary.evaluated_map_id << ", the longest: " << poses << " of "
+                << summary.tracked << " poses; each map in run.json)";
     }
     std::cout << "\n";
   }
@@ -47,52 +48,64 @@ void print_summary(const run::RunSummary& summary) {
     std::cout << "ATE alignment     sim3 (scale " << accuracy["sim3_scale"].get<double>() << ")\n";
   }
   if (summary.rpe_trans_rmse_m) std::cout << "RPE trans RMSE    " << *summary.rpe_trans_rmse_m << " m/s\n";
-  std::cout << "outputs           " << summary.out_dir << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json,report.html}\n";
+  std::cout << "outputs           " << summary.out_dir
+            << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json,report.html}\n";
 }
 }  // namespace
 
 void add_run_command(CLI::App& app, GlobalOptions& global) {
   auto args = std::make_shared<RunArgs>();
   auto* cmd = app.add_subcommand("run", "Run SLAM on a dataset and write trajectories and statistics");
-  cmd->add_option("--dataset,-d", args->options.dataset, "Dataset directory (TUM/Bonn, EuRoC, KITTI, images), video or camera index")
+  cmd->add_option("--dataset,-d", args->options.dataset,
+                  "Dataset directory (TUM/Bonn, EuRoC, KITTI, images), video or camera index")
       ->required();
-  cmd->add_option("--settings,-s", args->options.settings_path, "Settings YAML (default: DATASET/settings.yaml)");
-  cmd->add_option("--out,-o", args->options.out_dir, "Output directory (new or empty; see --overwrite)")->required();
+  cmd->add_option("--settings,-s", args->options.settings_path,
+                  "Settings YAML (default: DATASET/settings.yaml)");
+  cmd->add_option("--out,-o", args->options.out_dir, "Output directory (new or empty; see --overwrite)")
+      ->required();
   cmd->add_flag("--overwrite", args->options.overwrite, "Replace an earlier run's outputs in --out");
-  cmd->add_option("--sensor", args->sensor, "Override the sensor detected from the dataset: rgbd, stereo or mono (mono: the colour / left images only)");
+  cmd->add_option("--sensor", args->sensor,
+                  "Override the sensor detected from the dataset: rgbd, stereo or mono (mono: the colour / "
+                  "left images only)");
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
   cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)");
-  cmd->add_flag("!--no-people-filter", args->options.people_filter,
-                "Run without the people filter and without the feature-number update (static-world baseline)");
+  cmd->add_flag(
+      "!--no-people-filter", args->options.people_filter,
+      "Run without the people filter and without the feature-number update (static-world baseline)");
   cmd->add_option("--detections", args->options.detections_file,
                   "Person boxes from a MOT-format file (frame,id,x,y,w,h,conf,...) instead of the detector");
   cmd->add_option("--detector", args->options.detector_model,
                   "Detector model: body, coco, yolox, bytetrack, PATH.cfg or PATH.onnx (input, backend and "
                   "preprocessing from the Detector.* settings; docs/DETECTION.md)");
   cmd->add_option("--filter-mode", args->options.filter_mode, "People filter mode: paper or depth");
-  cmd->add_option("--detector-mode", args->options.detector_mode,
-                  "every_frame: each frame waits for its own boxes; latest: the detector takes the newest frame "
-                  "when free and other frames get its boxes moved by the image flow (Detector.mode)");
+  cmd->add_option(
+      "--detector-mode", args->options.detector_mode,
+      "every_frame: each frame waits for its own boxes; latest: the detector takes the newest frame "
+      "when free and other frames get its boxes moved by the image flow (Detector.mode)");
   cmd->add_option("--detector-interval", args->options.detector_interval,
                   "latest mode: offer the detector a frame at most every N frames (1 = whenever it is free; "
                   "Detector.latest_interval)");
-  cmd->add_option("--box-tracker", args->options.box_tracker,
-                  "on: boxes persist through missed detections and one-detection boxes are dropped (Detector.tracker)");
-  cmd->add_option("--geometry", args->options.geometry,
-                  "on (default): keypoints and map points that move against the estimated camera motion are kept "
-                  "out of tracking and mapping, with or without the people filter; off: the check is skipped "
-                  "(Geometry.dynamic_check)");
+  cmd->add_option(
+      "--box-tracker", args->options.box_tracker,
+      "on: boxes persist through missed detections and one-detection boxes are dropped (Detector.tracker)");
+  cmd->add_option(
+      "--geometry", args->options.geometry,
+      "on (default): keypoints and map points that move against the estimated camera motion are kept "
+      "out of tracking and mapping, with or without the people filter; off: the check is skipped "
+      "(Geometry.dynamic_check)");
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
-  cmd->add_option("--vocabulary", args->options.vocabulary,
-                  "ORB vocabulary for relocalisation (default: $CROWDSLAM_VOCABULARY or vocabulary/crowdslam_orb.voc); "
-                  "'none' relocalises by brute-force matching");
+  cmd->add_option(
+      "--vocabulary", args->options.vocabulary,
+      "ORB vocabulary for relocalisation (default: $CROWDSLAM_VOCABULARY or vocabulary/crowdslam_orb.voc); "
+      "'none' relocalises by brute-force matching");
   cmd->add_flag("!--no-loop-closing", args->options.loop_closing,
                 "Run without the loop closing thread (no place recognition, no pose-graph or global BA)");
-  cmd->add_option("--pace", args->pace,
-                  "none: every frame as fast as possible (default); sensor: replay at the recorded rate, dropping "
-                  "(and counting) frames that arrive while tracking is busy, as a live camera does")
+  cmd->add_option(
+         "--pace", args->pace,
+         "none: every frame as fast as possible (default); sensor: replay at the recorded rate, dropping "
+         "(and counting) frames that arrive while tracking is busy, as a live camera does")
       ->check(CLI::IsMember({"none", "sensor"}));
   cmd->add_flag("--skip-bad-frames", args->options.skip_bad_frames,
                 "Skip (count and warn about) frames that cannot be read instead of failing the run");
@@ -100,10 +113,12 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                 "Exit 0 even when no frame could be tracked");
   cmd->add_option("--save-map", args->options.save_map,
                   "Write the final map to this SQLite file (atomically; also for an interrupted run)");
-  cmd->add_option("--load-map", args->options.load_map,
-                  "Start in this saved map: relocalise into it, then extend it (or only track with --localization)");
-  cmd->add_flag("--viewer", args->options.viewer,
-                "Live web viewer during the run (map, keyframes, camera, image with people, status, pause/step)");
+  cmd->add_option(
+      "--load-map", args->options.load_map,
+      "Start in this saved map: relocalise into it, then extend it (or only track with --localization)");
+  cmd->add_flag(
+      "--viewer", args->options.viewer,
+      "Live web viewer during the run (map, keyframes, camera, image with people, status, pause/step)");
   cmd->add_option("--viewer-host", args->options.viewer_host,
                   "Address the viewer listens on (default 127.0.0.1; the viewer has no authentication)");
   cmd->add_option("--viewer-port", args->options.viewer_port, "Viewer port (default 8080; 0: any free port)")

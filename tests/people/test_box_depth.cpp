@@ -127,13 +127,15 @@ TEST(BoxDepth, ANarrowBoxAtTheLeftEdgeIsJudgedOnStripsWideEnoughToHoldDepth) {
     // A person in the box's middle, 0.5 m in front of the wall: stands out.
     cv::Mat person = wall.clone();
     add_slab(person, cv::Rect(static_cast<int>(x) + 70, 0, 60, 480), 0.5);
-    EXPECT_EQ(box_depth_test(person, kFactor, box, 0.2).verdict, BoxDepthVerdict::kStandsOut) << "box at x " << x;
+    EXPECT_EQ(box_depth_test(person, kFactor, box, 0.2).verdict, BoxDepthVerdict::kStandsOut)
+        << "box at x " << x;
   }
   // A box well inside the image with holes around it is still undecided.
   cv::Mat holes = plane_image(kOblique, 1.5);
   holes(cv::Rect(100, 0, 60, kHeight)).setTo(0);
   holes(cv::Rect(0, 0, kWidth, 40)).setTo(0);
-  EXPECT_EQ(box_depth_test(holes, kFactor, cv::Rect2f(160, 0, 200, 480), 0.2).verdict, BoxDepthVerdict::kUnknown);
+  EXPECT_EQ(box_depth_test(holes, kFactor, cv::Rect2f(160, 0, 200, 480), 0.2).verdict,
+            BoxDepthVerdict::kUnknown);
 }
 
 TEST(BoxDepth, NoDepthIsUndecided) {
@@ -153,4 +155,22 @@ TEST(BoxDepth, NoDepthIsUndecided) {
   cv::Mat wrong_type(kHeight, kWidth, CV_32FC1, cv::Scalar(2.0));
   EXPECT_EQ(box_depth_test(wrong_type, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict,
             BoxDepthVerdict::kUnknown);
+}
+
+TEST(BoxDepth, AnUndecidedRawBoxTakesTheVerdictOfTheNmsBoxItDuplicates) {
+  const std::vector<cv::Rect2f> nms = {{100, 50, 200, 400}, {400, 50, 150, 400}};
+  const std::vector<BoxDepthVerdict> verdicts = {BoxDepthVerdict::kFlat, BoxDepthVerdict::kStandsOut};
+  // Raw neighbours too small to test: the one over the poster (IoU 0.6 with the flat box) is flat, the
+  // one over the person is not.
+  EXPECT_TRUE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kUnknown, nms, verdicts));
+  EXPECT_FALSE(flat_by_leader({410, 60, 130, 380}, BoxDepthVerdict::kUnknown, nms, verdicts));
+  // Overlapping both, it follows the one it overlaps most (IoU 0.37 with the person's box, 0.05 with the
+  // poster).
+  EXPECT_FALSE(flat_by_leader({280, 50, 220, 400}, BoxDepthVerdict::kUnknown, nms, verdicts));
+  // A box decided on its own keeps its verdict, whatever its leader's.
+  EXPECT_FALSE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kStandsOut, nms, verdicts));
+  EXPECT_TRUE(flat_by_leader({410, 60, 130, 380}, BoxDepthVerdict::kFlat, nms, verdicts));
+  // No NMS box it overlaps, or none at all: not flat.
+  EXPECT_FALSE(flat_by_leader({600, 0, 30, 30}, BoxDepthVerdict::kUnknown, nms, verdicts));
+  EXPECT_FALSE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kUnknown, {}, {}));
 }

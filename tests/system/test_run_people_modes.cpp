@@ -6,10 +6,10 @@
 #include <set>
 #include <sstream>
 
+#include "blank_frames.h"
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
-#include "blank_frames.h"
 #include "test_support.h"
 
 using namespace crowdslam;

@@ -1,10 +1,10 @@
 // End-to-end: SLAM on sequences from the synthetic generator, against their exact ground truth.
 #include <gtest/gtest.h>
 
+#include "blank_frames.h"
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
-#include "blank_frames.h"
 #include "test_support.h"
 
 using namespace crowdslam;

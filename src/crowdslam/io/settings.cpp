@@ -178,9 +178,8 @@ bool operator==(const Settings& a, const Settings& b) {
                         da.input_size == db.input_size && da.input_width == db.input_width &&
                         da.input_height == db.input_height && da.backend == db.backend &&
                         da.preprocess == db.preprocess && da.resize == db.resize &&
-                        da.confidence == db.confidence &&
-                        da.nms == db.nms && da.person_class == db.person_class &&
-                        da.filter_before_nms == db.filter_before_nms &&
+                        da.confidence == db.confidence && da.nms == db.nms &&
+                        da.person_class == db.person_class && da.filter_before_nms == db.filter_before_nms &&
                         da.raw_box_max_area_ratio == db.raw_box_max_area_ratio;
   const bool people = a.people_filter.enabled == b.people_filter.enabled &&
                       a.people_filter.mode == b.people_filter.mode &&
@@ -190,12 +189,13 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.people_filter.flat_box_margin_m == b.people_filter.flat_box_margin_m;
   const auto& ga = a.geometry;
   const auto& gb = b.geometry;
-  const bool geometry = ga.dynamic_check == gb.dynamic_check && ga.moving_factor == gb.moving_factor &&
-                        ga.certain_factor == gb.certain_factor && ga.dynamic_score == gb.dynamic_score &&
-                        ga.cull_score == gb.cull_score && ga.region_radius_px == gb.region_radius_px &&
-                        ga.region_depth_m == gb.region_depth_m && ga.region_depth_ratio == gb.region_depth_ratio &&
-                        ga.region_steps == gb.region_steps && ga.free_space_margin_m == gb.free_space_margin_m &&
-                        ga.free_space_ratio == gb.free_space_ratio && ga.free_space_cull_run == gb.free_space_cull_run;
+  const bool geometry =
+      ga.dynamic_check == gb.dynamic_check && ga.moving_factor == gb.moving_factor &&
+      ga.certain_factor == gb.certain_factor && ga.dynamic_score == gb.dynamic_score &&
+      ga.cull_score == gb.cull_score && ga.region_radius_px == gb.region_radius_px &&
+      ga.region_depth_m == gb.region_depth_m && ga.region_depth_ratio == gb.region_depth_ratio &&
+      ga.region_steps == gb.region_steps && ga.free_space_margin_m == gb.free_space_margin_m &&
+      ga.free_space_ratio == gb.free_space_ratio && ga.free_space_cull_run == gb.free_space_cull_run;
   const bool budget = a.feature_budget.enabled == b.feature_budget.enabled &&
                       a.feature_budget.thresholds == b.feature_budget.thresholds &&
                       a.feature_budget.factors == b.feature_budget.factors &&

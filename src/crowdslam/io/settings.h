@@ -59,12 +59,12 @@ struct StereoRectification {
 };
 
 struct DetectorSettings {
-  std::string model_cfg;      // model name (body, coco, yolox, bytetrack), Darknet .cfg or .onnx (empty = body)
+  std::string model_cfg;  // model name (body, coco, yolox, bytetrack), Darknet .cfg or .onnx (empty = body)
   std::string model_weights;  // Darknet .weights
   int input_size = 160;       // square network input, multiple of 32 (shorthand for width = height)
   int input_width = 0;        // with input_height: a non-square input, e.g. 416 x 256 (0 = input_size)
   int input_height = 0;
-  std::string backend = "auto";     // auto | darknet | yolo-onnx | yolox (auto: the model's, else by extension)
+  std::string backend = "auto";  // auto | darknet | yolo-onnx | yolox (auto: the model's, else by extension)
   std::string preprocess = "auto";  // auto | darknet | yolox | bytetrack (auto: the model's / backend's)
   std::string resize = "auto";      // auto | stretch | letterbox (auto: the preprocessing's)
   double confidence = 0.2;
@@ -112,11 +112,11 @@ struct PeopleFilterSettings {
 
 // Geometric dynamic check of tracked keypoints against the static map (tracking/dynamic_check.h).
 struct GeometrySettings {
-  bool dynamic_check = true;  // off: --geometry off or Geometry.dynamic_check: 0
-  double moving_factor = 4.0;    // residual chi2 above this x the 95 % threshold counts as motion
-  double certain_factor = 0.0;   // one observation above this x makes a keypoint dynamic (0 = never)
-  int dynamic_score = 8;         // moving verdicts among a map point's last 8 that make its keypoints dynamic
-  int cull_score = 8;            // moving verdicts among its last 8 at which it is culled
+  bool dynamic_check = true;    // off: --geometry off or Geometry.dynamic_check: 0
+  double moving_factor = 4.0;   // residual chi2 above this x the 95 % threshold counts as motion
+  double certain_factor = 0.0;  // one observation above this x makes a keypoint dynamic (0 = never)
+  int dynamic_score = 8;        // moving verdicts among a map point's last 8 that make its keypoints dynamic
+  int cull_score = 8;           // moving verdicts among its last 8 at which it is culled
   double region_radius_px = 20.0;  // region growing radius at 640 px width
   double region_depth_m = 0.15;    // region growing depth tolerance (or region_depth_ratio x depth)
   double region_depth_ratio = 0.08;

@@ -1,9 +1,9 @@
 // Settings::check: every value validated, errors name the file and the key.
 #include <cmath>
 #include <initializer_list>
+#include <sstream>
 #include <string>
 #include <utility>
-#include <sstream>
 
 #include "crowdslam/io/input_text.h"
 #include "crowdslam/io/settings.h"
@@ -25,7 +25,8 @@ constexpr double kMaxBudgetFactor = 10.0;
 
 class Checker {
  public:
-  explicit Checker(const std::string& path) : path_(path.empty() ? std::string("settings") : clip_text(path)) {}
+  explicit Checker(const std::string& path)
+      : path_(path.empty() ? std::string("settings") : clip_text(path)) {}
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
     throw input_error(path_, key + ": " + reason);
@@ -170,13 +171,14 @@ void check_detector(const Checker& c, const DetectorSettings& d) {
             "in (0, 1]", d.confidence);
   c.require(std::isfinite(d.nms) && d.nms > 0 && d.nms <= 1, "Detector.nms", "in (0, 1]", d.nms);
   c.require(d.latest_interval >= 1, "Detector.latest_interval", ">= 1", d.latest_interval);
-  c.require(std::isfinite(d.raw_box_max_area_ratio) && (d.raw_box_max_area_ratio == 0 || d.raw_box_max_area_ratio >= 1),
+  c.require(std::isfinite(d.raw_box_max_area_ratio) &&
+                (d.raw_box_max_area_ratio == 0 || d.raw_box_max_area_ratio >= 1),
             "Detector.raw_box_max_area_ratio", "0 (off) or >= 1", d.raw_box_max_area_ratio);
   c.require(d.person_class >= 0, "Detector.person_class", ">= 0", d.person_class);
   c.require(d.mode == "every_frame" || d.mode == "latest", "Detector.mode", "\"every_frame\" or \"latest\"",
             "\"" + d.mode + "\"");
-  c.require(std::isfinite(d.track_iou) && d.track_iou > 0 && d.track_iou <= 1, "Detector.track_iou", "in (0, 1]",
-            d.track_iou);
+  c.require(std::isfinite(d.track_iou) && d.track_iou > 0 && d.track_iou <= 1, "Detector.track_iou",
+            "in (0, 1]", d.track_iou);
   c.require(d.track_min_hits >= 1, "Detector.track_min_hits", ">= 1", d.track_min_hits);
   c.require(d.track_max_misses >= 0, "Detector.track_max_misses", ">= 0", d.track_max_misses);
   c.require(std::isfinite(d.track_confirm_confidence) && d.track_confirm_confidence >= 0 &&
@@ -195,13 +197,14 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(p.depth_margin_m) && p.depth_margin_m >= 0, "PeopleFilter.depth_margin_m", ">= 0",
             p.depth_margin_m);
   c.require(p.static_check_below >= 0, "PeopleFilter.static_check_below", ">= 0", p.static_check_below);
-  c.require(std::isfinite(p.flat_box_margin_m) && p.flat_box_margin_m >= 0, "PeopleFilter.flat_box_margin_m", ">= 0",
-            p.flat_box_margin_m);
+  c.require(std::isfinite(p.flat_box_margin_m) && p.flat_box_margin_m >= 0, "PeopleFilter.flat_box_margin_m",
+            ">= 0", p.flat_box_margin_m);
   c.require(p.static_in_boxes == "monocular" || p.static_in_boxes == "always" || p.static_in_boxes == "never",
             "PeopleFilter.static_in_boxes", "\"monocular\", \"always\" or \"never\"",
             "\"" + p.static_in_boxes + "\"");
   const auto& g = s.geometry;
-  c.require(std::isfinite(g.moving_factor) && g.moving_factor > 0, "Geometry.moving_factor", "> 0", g.moving_factor);
+  c.require(std::isfinite(g.moving_factor) && g.moving_factor > 0, "Geometry.moving_factor", "> 0",
+            g.moving_factor);
   c.require(std::isfinite(g.certain_factor) && (g.certain_factor == 0 || g.certain_factor >= g.moving_factor),
             "Geometry.certain_factor", "0 (off) or >= Geometry.moving_factor", g.certain_factor);
   c.require(g.dynamic_score >= 1, "Geometry.dynamic_score", ">= 1", g.dynamic_score);
@@ -211,15 +214,16 @@ void check_own_sections(const Checker& c, const Settings& s) {
             g.region_radius_px);
   c.require(std::isfinite(g.region_depth_m) && g.region_depth_m >= 0, "Geometry.region_depth_m", ">= 0",
             g.region_depth_m);
-  c.require(std::isfinite(g.region_depth_ratio) && g.region_depth_ratio >= 0, "Geometry.region_depth_ratio", ">= 0",
-            g.region_depth_ratio);
-  c.require(g.region_steps >= 0 && g.region_steps <= 10, "Geometry.region_steps", "in [0, 10]", g.region_steps);
-  c.require(std::isfinite(g.free_space_margin_m) && g.free_space_margin_m >= 0, "Geometry.free_space_margin_m",
-            ">= 0 (0 = off)", g.free_space_margin_m);
+  c.require(std::isfinite(g.region_depth_ratio) && g.region_depth_ratio >= 0, "Geometry.region_depth_ratio",
+            ">= 0", g.region_depth_ratio);
+  c.require(g.region_steps >= 0 && g.region_steps <= 10, "Geometry.region_steps", "in [0, 10]",
+            g.region_steps);
+  c.require(std::isfinite(g.free_space_margin_m) && g.free_space_margin_m >= 0,
+            "Geometry.free_space_margin_m", ">= 0 (0 = off)", g.free_space_margin_m);
   c.require(std::isfinite(g.free_space_ratio) && g.free_space_ratio >= 0, "Geometry.free_space_ratio", ">= 0",
             g.free_space_ratio);
-  c.require(g.free_space_cull_run >= 1 && g.free_space_cull_run <= 8, "Geometry.free_space_cull_run", "in [1, 8]",
-            g.free_space_cull_run);
+  c.require(g.free_space_cull_run >= 1 && g.free_space_cull_run <= 8, "Geometry.free_space_cull_run",
+            "in [1, 8]", g.free_space_cull_run);
   const auto& b = s.feature_budget;
   if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
   for (std::size_t i = 0; i < b.thresholds.size(); ++i) {
@@ -254,9 +258,9 @@ void check_image_size(const Settings& settings, cv::Size image, const std::strin
   if (image.width == cam.width && image.height == cam.height) return;
   const std::string file = settings.path.empty() ? std::string("settings") : clip_text(settings.path);
   throw input_error(clip_text(image_path), "image is " + size_text(image.width, image.height) +
-                                             ", but the settings " + file + " give Camera.width/height " +
-                                             size_text(cam.width, cam.height) +
-                                             " (settings for another camera?)");
+                                               ", but the settings " + file + " give Camera.width/height " +
+                                               size_text(cam.width, cam.height) +
+                                               " (settings for another camera?)");
 }
 
 void Settings::check(SensorKind sensor) const {

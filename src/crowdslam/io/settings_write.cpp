@@ -92,14 +92,14 @@ void write_own_sections(std::ostream& out, const Settings& s) {
   if (d.backend != "auto") out << "\nDetector.backend: " << quoted(d.backend);
   if (d.preprocess != "auto") out << "\nDetector.preprocess: " << quoted(d.preprocess);
   if (d.resize != "auto") out << "\nDetector.resize: " << quoted(d.resize);
-  out
-      << "\nDetector.confidence: " << real_text(d.confidence) << "\nDetector.nms: " << real_text(d.nms)
+  out << "\nDetector.confidence: " << real_text(d.confidence) << "\nDetector.nms: " << real_text(d.nms)
       << "\nDetector.person_class: " << d.person_class
       << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0)
-      << "\nDetector.raw_box_max_area_ratio: " << real_text(d.raw_box_max_area_ratio) << "\nDetector.mode: " << quoted(d.mode)
-      << "\nDetector.latest_interval: " << d.latest_interval
+      << "\nDetector.raw_box_max_area_ratio: " << real_text(d.raw_box_max_area_ratio)
+      << "\nDetector.mode: " << quoted(d.mode) << "\nDetector.latest_interval: " << d.latest_interval
       << "\nDetector.tracker: " << (d.tracker ? 1 : 0) << "\nDetector.track_iou: " << real_text(d.track_iou)
-      << "\nDetector.track_min_hits: " << d.track_min_hits << "\nDetector.track_max_misses: " << d.track_max_misses
+      << "\nDetector.track_min_hits: " << d.track_min_hits
+      << "\nDetector.track_max_misses: " << d.track_max_misses
       << "\nDetector.track_confirm_confidence: " << real_text(d.track_confirm_confidence) << "\n\n";
   const auto& p = s.people_filter;
   out << "# Keypoints on people (mode \"paper\" or \"depth\")\nPeopleFilter.enabled: " << (p.enabled ? 1 : 0)
@@ -110,8 +110,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nPeopleFilter.static_check_below: " << p.static_check_below
       << "\nPeopleFilter.flat_box_margin_m: " << real_text(p.flat_box_margin_m) << "\n\n";
   const auto& g = s.geometry;
-  out << "# Geometric dynamic check of tracked keypoints\nGeometry.dynamic_check: " << (g.dynamic_check ? 1 : 0)
-      << "\nGeometry.moving_factor: " << real_text(g.moving_factor)
+  out << "# Geometric dynamic check of tracked keypoints\nGeometry.dynamic_check: "
+      << (g.dynamic_check ? 1 : 0) << "\nGeometry.moving_factor: " << real_text(g.moving_factor)
       << "\nGeometry.certain_factor: " << real_text(g.certain_factor)
       << "\nGeometry.dynamic_score: " << g.dynamic_score << "\nGeometry.cull_score: " << g.cull_score
       << "\nGeometry.region_radius_px: " << real_text(g.region_radius_px)

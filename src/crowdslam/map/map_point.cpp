@@ -9,8 +9,8 @@
 
 namespace crowdslam::map {
 
-MapPoint::MapPoint(uint64_t id_in, const geometry::Vec3& world, const std::shared_ptr<KeyFrame>& reference_keyframe,
-                   uint64_t first_frame_id_in)
+MapPoint::MapPoint(uint64_t id_in, const geometry::Vec3& world,
+                   const std::shared_ptr<KeyFrame>& reference_keyframe, uint64_t first_frame_id_in)
     : id(id_in),
       first_keyframe_id(reference_keyframe ? reference_keyframe->id : 0),
       first_frame_id(first_frame_id_in),
@@ -141,8 +141,8 @@ void MapPoint::compute_distinctive_descriptor() {
   size_t best = 0;
   std::vector<int> row(n);
   for (size_t i = 0; i < n; ++i) {
-    std::copy(distances.begin() + static_cast<long>(i * n), distances.begin() + static_cast<long>((i + 1) * n),
-              row.begin());
+    std::copy(distances.begin() + static_cast<long>(i * n),
+              distances.begin() + static_cast<long>((i + 1) * n), row.begin());
     std::nth_element(row.begin(), row.begin() + static_cast<long>((n - 1) / 2), row.end());
     const int median = row[(n - 1) / 2];
     if (median < best_median) {

@@ -7,6 +7,8 @@
 #include <optional>
 #include <vector>
 
+#include "crowdslam/people/detector.h"
+
 namespace crowdslam::people {
 
 namespace {
@@ -138,7 +140,8 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
       std::array<Patch, 3> p;
       const double x0 = left ? 0.0 : 1.0 - w;
       const double y[4] = {0.0, 0.33, 0.67, 1.0};
-      for (int k = 0; k < 3; ++k) p[static_cast<size_t>(k)] = patch(depth_image_raw, depth_factor, box, x0, y[k], x0 + w, y[k + 1]);
+      for (int k = 0; k < 3; ++k)
+        p[static_cast<size_t>(k)] = patch(depth_image_raw, depth_factor, box, x0, y[k], x0 + w, y[k + 1]);
       return p;
     };
     auto has_depth = [](const std::array<Patch, 3>& p) {
@@ -168,6 +171,21 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
   test.verdict =
       test.surface_m - test.torso_m > margin_m ? BoxDepthVerdict::kStandsOut : BoxDepthVerdict::kFlat;
   return test;
+}
+
+bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<cv::Rect2f>& nms_boxes,
+                    const std::vector<BoxDepthVerdict>& nms_verdicts) {
+  if (own != BoxDepthVerdict::kUnknown) return own == BoxDepthVerdict::kFlat;
+  double best = 0.0;
+  bool leader_flat = false;
+  for (size_t k = 0; k < nms_boxes.size() && k < nms_verdicts.size(); ++k) {
+    const double iou = box_iou(box, nms_boxes[k]);
+    if (iou > best) {
+      best = iou;
+      leader_flat = nms_verdicts[k] == BoxDepthVerdict::kFlat;
+    }
+  }
+  return leader_flat;
 }
 
 }  // namespace crowdslam::people

@@ -35,4 +35,11 @@ struct BoxDepthTest {
 BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
                             double margin_m);
 
+// Whether a raw (before-NMS) box is flat given its own verdict (`own`) and the NMS boxes with theirs: a
+// box decided on its own keeps its verdict; an undecided one (too small to test, no depth around it)
+// takes the verdict of the NMS box it overlaps most, the detection it duplicates (the raw neighbours of
+// a false positive on a poster are the same poster). Flat = kFlat.
+bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<cv::Rect2f>& nms_boxes,
+                    const std::vector<BoxDepthVerdict>& nms_verdicts);
+
 }  // namespace crowdslam::people

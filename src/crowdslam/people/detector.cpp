@@ -31,8 +31,8 @@ cv::Size DetectorOptions::input() const {
 void DetectorOptions::check() const {
   require(input_size >= 32 && input_size % 32 == 0, "input_size", "a multiple of 32 and >= 32", input_size);
   require(input_size <= kMaxInputSide, "input_size", "<= 2048", input_size);
-  require((input_width == 0) == (input_height == 0), "input_width / input_height",
-          "both set or both 0", std::to_string(input_width) + " / " + std::to_string(input_height));
+  require((input_width == 0) == (input_height == 0), "input_width / input_height", "both set or both 0",
+          std::to_string(input_width) + " / " + std::to_string(input_height));
   if (input_width != 0) {
     require(valid_side(input_width), "input_width", "a multiple of 32 in 32..2048", input_width);
     require(valid_side(input_height), "input_height", "a multiple of 32 in 32..2048", input_height);
@@ -55,7 +55,8 @@ cv::Size parse_input_size(const std::string& text, const std::string& key) {
       used = 0;
     }
     if (part.empty() || used != part.size() || !valid_side(value))
-      throw InputError(key + ": expected WIDTHxHEIGHT or one SIZE, each a multiple of 32 in 32..2048, got \"" +
+      throw InputError(key +
+                       ": expected WIDTHxHEIGHT or one SIZE, each a multiple of 32 in 32..2048, got \"" +
                        text + "\"");
     return value;
   };

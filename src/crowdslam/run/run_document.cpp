@@ -106,8 +106,9 @@ void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummar
 }
 
 void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
-                       const std::vector<io::Trajectory>& segments, const std::vector<system::MapSegment>& info,
-                       bool monocular, RunSummary& summary, nlohmann::json& accuracy) {
+                       const std::vector<io::Trajectory>& segments,
+                       const std::vector<system::MapSegment>& info, bool monocular, RunSummary& summary,
+                       nlohmann::json& accuracy) {
   accuracy = nullptr;
   if (ground_truth.empty()) return;
   nlohmann::json per_segment = nlohmann::json::array();
@@ -158,7 +159,8 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
     }
     if (!result.error.empty()) {
       entry["error"] = result.error;
-      if (longest && k == *longest) spdlog::warn("accuracy of map {} not evaluated: {}", result.map_id, result.error);
+      if (longest && k == *longest)
+        spdlog::warn("accuracy of map {} not evaluated: {}", result.map_id, result.error);
     }
     if (longest && k == *longest) {
       summary.ate_rmse_m = result.ate_rmse_m;
@@ -175,15 +177,13 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
   accuracy["segments"] = per_segment;
 }
 
-nlohmann::json running_document(const RunOptions& options, const std::string& settings_path, io::SensorKind sensor) {
-  return {{"crowdslam_version", CROWDSLAM_VERSION},
-          {"end_state", "running"},
-          {"pid", static_cast<long>(::getpid())},
-          {"started", utc_now()},
-          {"dataset", dataset_path(options.dataset)},
-          {"settings", settings_path},
-          {"sensor", io::to_string(sensor)},
-          {"mode", options.sequential ? "sequential" : "threaded"}};
+nlohmann::json running_document(const RunOptions& options, const std::string& settings_path,
+                                io::SensorKind sensor) {
+  return {
+      {"crowdslam_version", CROWDSLAM_VERSION},   {"end_state", "running"},
+      {"pid", static_cast<long>(::getpid())},     {"started", utc_now()},
+      {"dataset", dataset_path(options.dataset)}, {"settings", settings_path},
+      {"sensor", io::to_string(sensor)},          {"mode", options.sequential ? "sequential" : "threaded"}};
 }
 
 nlohmann::json final_document(const RunContext& c, const std::vector<system::FrameReport>& reports,
@@ -195,7 +195,8 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   doc["end_state"] = summary.end.to_string();
   doc["finished"] = utc_now();
   if (const auto& vocabulary = slam.vocabulary_info()) {
-    doc["vocabulary"] = {{"path", vocabulary->path}, {"words", vocabulary->words}, {"load_ms", vocabulary->load_ms}};
+    doc["vocabulary"] = {
+        {"path", vocabulary->path}, {"words", vocabulary->words}, {"load_ms", vocabulary->load_ms}};
   } else {
     doc["vocabulary"] = nullptr;
   }
@@ -224,37 +225,37 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     frames_waited += r.waited_for_mapping_ms > 0 ? 1 : 0;
   }
   const system::PeopleStage* people = slam.people_stage();
-  doc["people_filter"] = people != nullptr
-                             ? nlohmann::json{{"detector", slam.detector_name()},
-                                              {"detector_mode", system::to_string(people->mode())},
-                                              {"latest_interval", s.detector.latest_interval},
-                                              {"box_tracker", people->tracker_enabled()},
-                                              {"detections", people->stats().detections},
-                                              {"frames_detected", people->stats().frames_detected},
-                                              {"frames_propagated", people->stats().frames_propagated},
-                                              {"boxes_moved", people->stats().boxes_moved},
-                                              {"boxes_kept_in_place", people->stats().boxes_kept_in_place},
-                                              {"tracks_started", people->stats().tracks_started},
-                                              {"flat_boxes", people->stats().flat_boxes},
-                                              {"frames_with_flat_boxes", people->stats().frames_with_flat_boxes},
-                                              {"flat_box_margin_m", s.people_filter.flat_box_margin_m},
-                                              {"mode", s.people_filter.mode},
-                                              {"margin_px", s.people_filter.margin_px},
-                                              {"filter_before_nms", s.detector.filter_before_nms},
-                                              {"raw_box_max_area_ratio", s.detector.raw_box_max_area_ratio},
-                                              {"raw_boxes_dropped", people->stats().raw_boxes_dropped},
-                                              {"static_in_boxes", s.people_filter.static_in_boxes},
-                                              {"static_check_below", s.people_filter.static_check_below},
-                                              {"frames_with_box_matches", frames_with_box_matches},
-                                              {"box_matches", box_matches},
-                                              {"frames_with_static_boxes", frames_with_static_boxes},
-                                              {"frames_rescued_with_boxes", rescued},
-                                              {"feature_budget", s.feature_budget.enabled},
-                                              {"area", s.feature_budget.area},
-                                              {"detector_ms_median", percentile(detector_ms, 0.5)},
-                                              {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
-                                              {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
-                             : nlohmann::json(nullptr);
+  doc["people_filter"] =
+      people != nullptr ? nlohmann::json{{"detector", slam.detector_name()},
+                                         {"detector_mode", system::to_string(people->mode())},
+                                         {"latest_interval", s.detector.latest_interval},
+                                         {"box_tracker", people->tracker_enabled()},
+                                         {"detections", people->stats().detections},
+                                         {"frames_detected", people->stats().frames_detected},
+                                         {"frames_propagated", people->stats().frames_propagated},
+                                         {"boxes_moved", people->stats().boxes_moved},
+                                         {"boxes_kept_in_place", people->stats().boxes_kept_in_place},
+                                         {"tracks_started", people->stats().tracks_started},
+                                         {"flat_boxes", people->stats().flat_boxes},
+                                         {"frames_with_flat_boxes", people->stats().frames_with_flat_boxes},
+                                         {"flat_box_margin_m", s.people_filter.flat_box_margin_m},
+                                         {"mode", s.people_filter.mode},
+                                         {"margin_px", s.people_filter.margin_px},
+                                         {"filter_before_nms", s.detector.filter_before_nms},
+                                         {"raw_box_max_area_ratio", s.detector.raw_box_max_area_ratio},
+                                         {"raw_boxes_dropped", people->stats().raw_boxes_dropped},
+                                         {"static_in_boxes", s.people_filter.static_in_boxes},
+                                         {"static_check_below", s.people_filter.static_check_below},
+                                         {"frames_with_box_matches", frames_with_box_matches},
+                                         {"box_matches", box_matches},
+                                         {"frames_with_static_boxes", frames_with_static_boxes},
+                                         {"frames_rescued_with_boxes", rescued},
+                                         {"feature_budget", s.feature_budget.enabled},
+                                         {"area", s.feature_budget.area},
+                                         {"detector_ms_median", percentile(detector_ms, 0.5)},
+                                         {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
+                                         {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
+                        : nlohmann::json(nullptr);
   const auto& g = s.geometry;
   doc["geometry"] = {{"dynamic_check", g.dynamic_check},
                      {"moving_factor", g.moving_factor},
@@ -268,26 +269,28 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                      {"map_points_culled_moving", culled_total},
                      {"map_point_verdicts_seen_through", seen_through_total},
                      {"frames_tracked_without_check", frames_check_skipped}};
-  doc["summary"] = {{"frames", summary.frames},
-                    {"tracked_frames", summary.tracked},
-                    {"tracked_percent", summary.tracked_percent},
-                    {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
-                    {"frames_localized_before_init", summary.frames_localized_before_init},
-                    {"wall_time_s", c.wall_s},
-                    {"throughput_fps", summary.throughput_fps},
-                    {"tracking_ms_median", summary.tracking_ms_median},
-                    {"tracking_ms_p95", summary.tracking_ms_p95},
-                    {"extraction_ms_median", summary.extraction_ms_median},
-                    {"total_ms_median", summary.total_ms_median},
-                    {"total_ms_p95", summary.total_ms_p95},
-                    {"load_wait_ms_median", percentile(c.load_ms, 0.5)},
-                    {"keyframes", slam.num_keyframes()},
-                    {"map_points", slam.num_map_points()},
-                    {"map_resets", slam.map_resets()},
-                    {"waited_for_mapping_ms", waited_for_mapping_ms},
-                    {"frames_waited_for_mapping", frames_waited},
-                    {"ate_rmse_m", optional_json(summary.ate_rmse_m)},
-                    {"ate_map_id", summary.evaluated_map_id ? nlohmann::json(*summary.evaluated_map_id) : nlohmann::json(nullptr)}};
+  doc["summary"] = {
+      {"frames", summary.frames},
+      {"tracked_frames", summary.tracked},
+      {"tracked_percent", summary.tracked_percent},
+      {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
+      {"frames_localized_before_init", summary.frames_localized_before_init},
+      {"wall_time_s", c.wall_s},
+      {"throughput_fps", summary.throughput_fps},
+      {"tracking_ms_median", summary.tracking_ms_median},
+      {"tracking_ms_p95", summary.tracking_ms_p95},
+      {"extraction_ms_median", summary.extraction_ms_median},
+      {"total_ms_median", summary.total_ms_median},
+      {"total_ms_p95", summary.total_ms_p95},
+      {"load_wait_ms_median", percentile(c.load_ms, 0.5)},
+      {"keyframes", slam.num_keyframes()},
+      {"map_points", slam.num_map_points()},
+      {"map_resets", slam.map_resets()},
+      {"waited_for_mapping_ms", waited_for_mapping_ms},
+      {"frames_waited_for_mapping", frames_waited},
+      {"ate_rmse_m", optional_json(summary.ate_rmse_m)},
+      {"ate_map_id",
+       summary.evaluated_map_id ? nlohmann::json(*summary.evaluated_map_id) : nlohmann::json(nullptr)}};
   nlohmann::json segments = nlohmann::json::array();
   for (const auto& segment : summary.segments) segments.push_back(segment_json(segment));
   doc["segments"] = segments;
@@ -314,12 +317,13 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     for (const auto& k : mapper.per_keyframe) values.push_back(k.*field);
     return nlohmann::json{{"median", percentile(values, 0.5)}, {"p95", percentile(values, 0.95)}};
   };
-  doc["local_mapping"]["per_keyframe_ms"] = {{"register", step(&mapping::KeyframeStepTimes::register_ms)},
-                                             {"triangulation", step(&mapping::KeyframeStepTimes::triangulation_ms)},
-                                             {"fusion", step(&mapping::KeyframeStepTimes::fusion_ms)},
-                                             {"local_ba", step(&mapping::KeyframeStepTimes::ba_ms)},
-                                             {"culling", step(&mapping::KeyframeStepTimes::culling_ms)},
-                                             {"total", step(&mapping::KeyframeStepTimes::total_ms)}};
+  doc["local_mapping"]["per_keyframe_ms"] = {
+      {"register", step(&mapping::KeyframeStepTimes::register_ms)},
+      {"triangulation", step(&mapping::KeyframeStepTimes::triangulation_ms)},
+      {"fusion", step(&mapping::KeyframeStepTimes::fusion_ms)},
+      {"local_ba", step(&mapping::KeyframeStepTimes::ba_ms)},
+      {"culling", step(&mapping::KeyframeStepTimes::culling_ms)},
+      {"total", step(&mapping::KeyframeStepTimes::total_ms)}};
   // Each keyframe's times, in the order the mapper processed them (n counts from 0; the mapper does not
   // record keyframe ids with its times).
   nlohmann::json keyframe_times = nlohmann::json::array();
@@ -345,15 +349,16 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                         {"matches", e.matches},
                         {"correction_ms", e.correction_ms}});
     }
-    doc["loop_closing"] = {{"keyframes_checked", loops.keyframes_checked},
-                           {"candidates_consistent", loops.candidates_consistent},
-                           {"candidates_rejected", loops.candidates_rejected},
-                           {"loops", events},
-                           {"detection_ms_mean", loops.detection_ms_total / std::max(1, loops.keyframes_checked)},
-                           {"global_ba_runs", loops.global_ba.runs},
-                           {"global_ba_applied", loops.global_ba.applied},
-                           {"global_ba_aborted", loops.global_ba.aborted},
-                           {"global_ba_ms_mean", loops.global_ba.time_ms_total / std::max(1, loops.global_ba.runs)}};
+    doc["loop_closing"] = {
+        {"keyframes_checked", loops.keyframes_checked},
+        {"candidates_consistent", loops.candidates_consistent},
+        {"candidates_rejected", loops.candidates_rejected},
+        {"loops", events},
+        {"detection_ms_mean", loops.detection_ms_total / std::max(1, loops.keyframes_checked)},
+        {"global_ba_runs", loops.global_ba.runs},
+        {"global_ba_applied", loops.global_ba.applied},
+        {"global_ba_aborted", loops.global_ba.aborted},
+        {"global_ba_ms_mean", loops.global_ba.time_ms_total / std::max(1, loops.global_ba.runs)}};
   } else {
     doc["loop_closing"] = nullptr;
   }

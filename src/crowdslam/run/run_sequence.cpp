@@ -16,9 +16,9 @@
 #include "crowdslam/run/frame_prefetcher.h"
 #include "crowdslam/run/input_checks.h"
 #include "crowdslam/run/map_files.h"
+#include "crowdslam/run/run_document.h"
 #include "crowdslam/run/sensor_pacer.h"
 #include "crowdslam/run/viewer_session.h"
-#include "crowdslam/run/run_document.h"
 #include "crowdslam/system/system.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
@@ -49,8 +49,9 @@ void prepare_stereo_settings(const io::FrameSource& source, io::Settings& settin
   }
   const auto& c = settings.camera;
   if (c.k1 != 0 || c.k2 != 0 || c.p1 != 0 || c.p2 != 0 || c.k3 != 0) {
-    throw input_error(settings.path, "Camera.k1/k2/p1/p2/k3: stereo images must be rectified, but the camera has "
-                                     "distortion and the settings have no LEFT/RIGHT rectification blocks");
+    throw input_error(settings.path,
+                      "Camera.k1/k2/p1/p2/k3: stereo images must be rectified, but the camera has "
+                      "distortion and the settings have no LEFT/RIGHT rectification blocks");
   }
 }
 
@@ -84,7 +85,8 @@ Prepared prepare(const RunOptions& options) {
   }
   p.settings_path = options.settings_path.empty() ? p.source->default_settings_path() : options.settings_path;
   if (p.settings_path.empty()) {
-    throw InputError(clip_text(options.dataset) + ": no settings given (--settings) and the dataset has no settings.yaml");
+    throw InputError(clip_text(options.dataset) +
+                     ": no settings given (--settings) and the dataset has no settings.yaml");
   }
   check_requested_sensor(*p.source, options.sensor);
   p.settings = io::load_settings(p.settings_path, options.sensor.value_or(p.source->sensor()));
@@ -92,7 +94,8 @@ Prepared prepare(const RunOptions& options) {
   p.run_settings = p.settings;
   if (!options.filter_mode.empty()) {
     if (options.filter_mode != "paper" && options.filter_mode != "depth") {
-      throw InputError("--filter-mode: expected 'paper' or 'depth', got '" + clip_text(options.filter_mode, 60) + "'");
+      throw InputError("--filter-mode: expected 'paper' or 'depth', got '" +
+                       clip_text(options.filter_mode, 60) + "'");
     }
     p.run_settings.people_filter.mode = options.filter_mode;
   }
@@ -112,7 +115,8 @@ Prepared prepare(const RunOptions& options) {
   }
   if (!options.box_tracker.empty()) {
     if (options.box_tracker != "on" && options.box_tracker != "off") {
-      throw InputError("--box-tracker: expected 'on' or 'off', got '" + clip_text(options.box_tracker, 60) + "'");
+      throw InputError("--box-tracker: expected 'on' or 'off', got '" + clip_text(options.box_tracker, 60) +
+                       "'");
     }
     p.run_settings.detector.tracker = options.box_tracker == "on";
   }
@@ -127,8 +131,8 @@ Prepared prepare(const RunOptions& options) {
   return p;
 }
 
-void write_final_outputs(const std::filesystem::path& out, const system::System& slam, io::TrajectoryFormat format,
-                         const nlohmann::json& doc) {
+void write_final_outputs(const std::filesystem::path& out, const system::System& slam,
+                         io::TrajectoryFormat format, const nlohmann::json& doc) {
   io::write_trajectory((out / "CameraTrajectory.txt").string(), slam.camera_trajectory(), format);
   io::write_trajectory((out / "KeyFrameTrajectory.txt").string(), slam.keyframe_trajectory(), format);
   write_file_atomic(out / "run.json", doc.dump(1) + "\n");
@@ -138,8 +142,8 @@ void write_final_outputs(const std::filesystem::path& out, const system::System&
 std::string progress_detail(const system::System& slam, const system::FrameReport& report) {
   char detail[160];
   std::snprintf(detail, sizeof detail, "%s  tracked %zu  keyframes %zu  points %zu  people %.0f %%",
-                tracking::to_string(report.state), slam.tracked_frames(), slam.num_keyframes(), slam.num_map_points(),
-                100.0 * report.people_area);
+                tracking::to_string(report.state), slam.tracked_frames(), slam.num_keyframes(),
+                slam.num_map_points(), 100.0 * report.people_area);
   return detail;
 }
 }  // namespace
@@ -165,7 +169,8 @@ RunSummary run_sequence(const RunOptions& options) {
   std::error_code ec;
   const bool created = !std::filesystem::exists(out, ec);
   const auto removed = journal::prepare_output_dir(out, options.overwrite);
-  if (!removed.empty()) spdlog::info("{}: replaced the earlier run ({} entries)", clip_text(options.out_dir), removed.size());
+  if (!removed.empty())
+    spdlog::info("{}: replaced the earlier run ({} entries)", clip_text(options.out_dir), removed.size());
   const auto format = io::parse_trajectory_format(p.settings.output.trajectory_format);
   journal::RunJournalOptions journal_options;
   journal_options.out_dir = out;
@@ -199,7 +204,9 @@ RunSummary run_sequence(const RunOptions& options) {
   std::optional<SensorPacer> pacer;
   size_t dropped_after_tracking = 0;
   if (options.pace_sensor) pacer.emplace();
-  const size_t progress_total = options.max_frames > 0 && (expected == 0 || options.max_frames < expected) ? options.max_frames : expected;
+  const size_t progress_total = options.max_frames > 0 && (expected == 0 || options.max_frames < expected)
+                                    ? options.max_frames
+                                    : expected;
   ProgressLine progress(options.progress, progress_total, "frame");
   try {
     while (true) {
@@ -253,7 +260,8 @@ RunSummary run_sequence(const RunOptions& options) {
     }
   }
   if (end.kind == system::EndState::Kind::kInterrupted) {
-    spdlog::warn("run interrupted by {} after {} frames; writing the outputs", signal_name(end.signal), reports.size());
+    spdlog::warn("run interrupted by {} after {} frames; writing the outputs", signal_name(end.signal),
+                 reports.size());
   }
   if (viewer) {
     viewer->set_progress(reports.size(), true);
@@ -276,16 +284,18 @@ RunSummary run_sequence(const RunOptions& options) {
   summary.frames = reports.size();
   summary.tracked = slam.tracked_frames();
   summary.tracked_percent =
-      summary.frames > 0 ? 100.0 * static_cast<double>(summary.tracked) / static_cast<double>(summary.frames) : 0.0;
+      summary.frames > 0 ? 100.0 * static_cast<double>(summary.tracked) / static_cast<double>(summary.frames)
+                         : 0.0;
   summary.throughput_fps = wall_s > 0 ? static_cast<double>(summary.frames) / wall_s : 0.0;
   summary.segments = slam.segments();
   summarise_frames(reports, summary);
   monitor.warn_totals();
   if (p.sensor == io::SensorKind::kMonocular && !summary.init_frame && summary.frames > 0 &&
       options.load_map.empty()) {  // a loaded map needs no initialisation
-    spdlog::warn("{}: monocular map never initialised in {} frames (needs a textured scene and a camera that "
-                 "translates, not only rotates)",
-                 clip_text(options.dataset), summary.frames);
+    spdlog::warn(
+        "{}: monocular map never initialised in {} frames (needs a textured scene and a camera that "
+        "translates, not only rotates)",
+        clip_text(options.dataset), summary.frames);
   }
   const bool untracked = end.completed() && summary.tracked == 0 && !options.allow_untracked;
   if (untracked) {
@@ -296,29 +306,36 @@ RunSummary run_sequence(const RunOptions& options) {
 
   nlohmann::json accuracy = nullptr;
   const auto ground_truth_name = p.source->summary().ground_truth_path;
-  evaluate_accuracy(p.source->ground_truth(), ground_truth_name.empty() ? "ground truth" : clip_text(ground_truth_name),
-                    slam.camera_trajectory_segments(), summary.segments, p.sensor == io::SensorKind::kMonocular,
-                    summary, accuracy);
+  evaluate_accuracy(p.source->ground_truth(),
+                    ground_truth_name.empty() ? "ground truth" : clip_text(ground_truth_name),
+                    slam.camera_trajectory_segments(), summary.segments,
+                    p.sensor == io::SensorKind::kMonocular, summary, accuracy);
   const SkippedFrames skipped = prefetcher.skipped();
   nlohmann::json input = monitor.to_json();
   input["pace"] = pacer ? "sensor" : "none";
   input["dropped_frames"] = pacer ? pacer->dropped() : 0;
   input["dropped_after_first_tracked"] = dropped_after_tracking;
   if (pacer && pacer->dropped() > 0) {
-    spdlog::info("--pace sensor: {} frames dropped because tracking was busy when they arrived ({} after the first "
-                 "tracked frame)", pacer->dropped(), dropped_after_tracking);
+    spdlog::info(
+        "--pace sensor: {} frames dropped because tracking was busy when they arrived ({} after the first "
+        "tracked frame)",
+        pacer->dropped(), dropped_after_tracking);
   }
   input["skipped_frames"] = skipped.count;
-  input["first_skipped_error"] = skipped.first_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(skipped.first_error);
-  if (skipped.count > 1) spdlog::warn("{} unreadable frames skipped (first: {})", skipped.count, skipped.first_error);
-  const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam, wall_s, load_ms, input, map_json};
+  input["first_skipped_error"] =
+      skipped.first_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(skipped.first_error);
+  if (skipped.count > 1)
+    spdlog::warn("{} unreadable frames skipped (first: {})", skipped.count, skipped.first_error);
+  const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam,
+                           wall_s,  load_ms,         input,    map_json};
   summary.json = final_document(context, reports, summary, accuracy);
   write_final_outputs(out, slam, format, summary.json);
   report::write_run_report(out, summary.json);  // never fails the run: logged, recorded in run.json
 
   if (error) {
-    const std::string where = " (the " + std::to_string(summary.tracked) + " frames tracked before it are in " +
-                              clip_text(options.out_dir) + ", run.json says \"failed\")";
+    const std::string where = " (the " + std::to_string(summary.tracked) +
+                              " frames tracked before it are in " + clip_text(options.out_dir) +
+                              ", run.json says \"failed\")";
     try {
       std::rethrow_exception(error);
     } catch (const InputError& e) {
@@ -326,8 +343,8 @@ RunSummary run_sequence(const RunOptions& options) {
     }
   }
   if (untracked) {
-    throw InputError(clip_text(options.dataset) + ": " + end.reason +
-                     "; outputs are in " + clip_text(options.out_dir) + " (--allow-untracked accepts such a run)");
+    throw InputError(clip_text(options.dataset) + ": " + end.reason + "; outputs are in " +
+                     clip_text(options.out_dir) + " (--allow-untracked accepts such a run)");
   }
   return summary;
 }

@@ -20,11 +20,10 @@
 //   - failed: an error mid-sequence (e.g. an unreadable frame, a write error): what was tracked is
 //     written with "failed: <reason>" and the error is rethrown (exit 1 in the app).
 // Errors found before the first frame (settings, dataset, --out) leave nothing behind.
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/system/run_observer.h"
@@ -35,25 +34,25 @@ struct RunOptions {
   std::string dataset;        // directory, video file or camera index
   std::string settings_path;  // empty: DATASET/settings.yaml
   std::string out_dir;
-  bool overwrite = false;     // --overwrite: replace an earlier run in out_dir
+  bool overwrite = false;                // --overwrite: replace an earlier run in out_dir
   std::optional<io::SensorKind> sensor;  // override the sensor detected from the dataset
   bool sequential = false;
   size_t max_frames = 0;  // 0 = all
   bool progress = true;
-  bool people_filter = true;        // --no-people-filter: static-world baseline (no filter, no FNU)
-  std::string detections_file;      // --detections: MOT-format boxes instead of the network
-  std::string detector_model;       // --detector: body | coco | PATH.cfg | PATH.onnx
-  std::string filter_mode;          // --filter-mode: overrides PeopleFilter.mode (paper | depth)
-  std::string detector_mode;        // --detector-mode: overrides Detector.mode (every_frame | latest)
-  int detector_interval = 0;        // --detector-interval: overrides Detector.latest_interval (0 = keep)
-  std::string box_tracker;          // --box-tracker: overrides Detector.tracker (on | off)
-  std::string geometry;             // --geometry: overrides Geometry.dynamic_check (on | off)
-  size_t save_frames = 0;           // --save-frames N: every N-th frame drawn into OUT/frames/
-  std::string vocabulary;           // --vocabulary FILE | none ("" = the default vocabulary)
-  bool loop_closing = true;         // --no-loop-closing
-  bool skip_bad_frames = false;     // --skip-bad-frames: an unreadable frame is counted and skipped
-  bool allow_untracked = false;     // --allow-untracked: a run that tracks no frame is not an error
-  size_t journal_flush_frames = 10; // the trajectory journal is flushed every N tracked frames
+  bool people_filter = true;         // --no-people-filter: static-world baseline (no filter, no FNU)
+  std::string detections_file;       // --detections: MOT-format boxes instead of the network
+  std::string detector_model;        // --detector: body | coco | PATH.cfg | PATH.onnx
+  std::string filter_mode;           // --filter-mode: overrides PeopleFilter.mode (paper | depth)
+  std::string detector_mode;         // --detector-mode: overrides Detector.mode (every_frame | latest)
+  int detector_interval = 0;         // --detector-interval: overrides Detector.latest_interval (0 = keep)
+  std::string box_tracker;           // --box-tracker: overrides Detector.tracker (on | off)
+  std::string geometry;              // --geometry: overrides Geometry.dynamic_check (on | off)
+  size_t save_frames = 0;            // --save-frames N: every N-th frame drawn into OUT/frames/
+  std::string vocabulary;            // --vocabulary FILE | none ("" = the default vocabulary)
+  bool loop_closing = true;          // --no-loop-closing
+  bool skip_bad_frames = false;      // --skip-bad-frames: an unreadable frame is counted and skipped
+  bool allow_untracked = false;      // --allow-untracked: a run that tracks no frame is not an error
+  size_t journal_flush_frames = 10;  // the trajectory journal is flushed every N tracked frames
   // --pace sensor: frames are replayed at their timestamps (as a live camera delivers them); a frame
   // whose successor has already arrived when tracking gets to it is dropped and counted, as a camera
   // driver drops frames nobody took. Default: every frame, as fast as the system goes.
@@ -86,7 +85,8 @@ struct RunSummary {
   size_t tracked = 0;  // == poses in CameraTrajectory.txt
   double tracked_percent = 0;
   std::optional<size_t> init_frame;  // index of the first frame that initialised a map
-  size_t frames_localized_before_init = 0;  // monocular: earlier frames the new maps localised (included in tracked)
+  size_t frames_localized_before_init =
+      0;  // monocular: earlier frames the new maps localised (included in tracked)
   double throughput_fps = 0;
   double tracking_ms_median = 0;
   double tracking_ms_p95 = 0;

@@ -22,8 +22,8 @@ constexpr double kSparseDepthFactor = 1000.0;  // millimetres in the stereo spar
 // CV_16UC1 image (depth * factor, 0 = none) with each keypoint's stereo depth written into a square
 // block. people::estimate_person_depth samples a box every sqrt(area / 2000) pixels; blocks that wide are
 // sampled at least once, so every keypoint in a box's centre counts.
-cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vector<float>& depth_m, cv::Size size,
-                           double factor) {
+cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vector<float>& depth_m,
+                           cv::Size size, double factor) {
   cv::Mat image(size, CV_16UC1, cv::Scalar(0));
   const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(size.area() / 2000.0))));
   const cv::Rect inside(0, 0, size.width, size.height);
@@ -132,8 +132,9 @@ std::vector<int> leaders_of(const std::vector<people::FlowBox>& boxes, const std
 // Moves `boxes` from `from` to `to`: boxes without a leader by the flow of their corners, the others
 // (raw boxes) by their leader's motion. `nms` and `leader` (one entry per box, may be null) follow their
 // boxes; a box that leaves the image is removed.
-void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& to, std::vector<people::FlowBox>& boxes,
-                       std::vector<bool>* nms, std::vector<int>* leader) {
+void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& to,
+                       std::vector<people::FlowBox>& boxes, std::vector<bool>* nms,
+                       std::vector<int>* leader) {
   const auto has_leader = [&](size_t i) { return leader != nullptr && (*leader)[i] >= 0; };
   std::vector<people::FlowBox> tracked;
   std::vector<cv::Point2f> centre(boxes.size());
@@ -161,7 +162,8 @@ void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& t
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (!has_leader(i)) continue;
     const auto l = static_cast<size_t>((*leader)[i]);
-    const cv::Rect2f r = people::follow_motion(boxes[i].box.box, centre[l], motion[l], to.gray.cols, to.gray.rows);
+    const cv::Rect2f r =
+        people::follow_motion(boxes[i].box.box, centre[l], motion[l], to.gray.cols, to.gray.rows);
     if (!(r.width > 0) || !(r.height > 0)) continue;
     moved[i] = boxes[i];
     moved[i]->box.box = r;
@@ -179,7 +181,8 @@ void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& t
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (new_index[i] < 0) continue;
     if (nms != nullptr && !nms->empty()) flags.push_back((*nms)[i]);
-    if (leader != nullptr) leaders.push_back(has_leader(i) ? new_index[static_cast<size_t>((*leader)[i])] : -1);
+    if (leader != nullptr)
+      leaders.push_back(has_leader(i) ? new_index[static_cast<size_t>((*leader)[i])] : -1);
   }
   boxes = std::move(out);
   if (nms != nullptr) *nms = std::move(flags);
@@ -187,7 +190,8 @@ void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& t
 }
 
 void PeopleStage::move_to(const people::FlowImage& image) {
-  if (!current_.empty() && current_.gray.size() == image.gray.size() && current_.gray.data != image.gray.data) {
+  if (!current_.empty() && current_.gray.size() == image.gray.size() &&
+      current_.gray.data != image.gray.data) {
     if (tracker_) {
       std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
       if (!boxes.empty()) {
@@ -236,7 +240,8 @@ void PeopleStage::take_detection(people::WorkerResult result, const people::Flow
     std::vector<people::FlowBox> refreshed;
     for (size_t i : tracker_->refreshed()) refreshed.push_back(boxes[i]);
     people::seed_points(image.gray, refreshed, flow_options_);
-    for (size_t k = 0; k < refreshed.size(); ++k) boxes[tracker_->refreshed()[k]].points = refreshed[k].points;
+    for (size_t k = 0; k < refreshed.size(); ++k)
+      boxes[tracker_->refreshed()[k]].points = refreshed[k].points;
     tracker_->apply_moved(boxes);
   } else {
     // The moved boxes keep the corners that followed them; boxes left with few (or none, when the
@@ -269,7 +274,8 @@ void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv
 
 std::vector<people::PersonBox> PeopleStage::masking_raw_boxes(const people::Detections& detections) {
   int dropped = 0;
-  std::vector<people::PersonBox> raw = people::raw_boxes_near_leaders(detections, raw_box_max_area_ratio_, &dropped);
+  std::vector<people::PersonBox> raw =
+      people::raw_boxes_near_leaders(detections, raw_box_max_area_ratio_, &dropped);
   stats_.raw_boxes_dropped += static_cast<std::size_t>(dropped);
   return raw;
 }
@@ -346,16 +352,25 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     // test misjudges people (partly in view at the image's edge, or far away among others).
     const double min_area = kFlatTestMinArea * depth_image.cols * depth_image.rows;
     // The NMS boxes are among the raw boxes too: each box is tested once.
-    std::vector<std::pair<cv::Rect2f, bool>> tested;
-    auto flat = [&](const people::PersonBox& b) {
-      if (b.box.area() < min_area) return false;
-      for (const auto& [box, verdict] : tested) {
-        if (box == b.box) return verdict;
+    std::vector<std::pair<cv::Rect2f, people::BoxDepthVerdict>> tested;
+    auto verdict = [&](const people::PersonBox& b) {
+      if (b.box.area() < min_area) return people::BoxDepthVerdict::kUnknown;
+      for (const auto& [box, v] : tested) {
+        if (box == b.box) return v;
       }
-      const bool is_flat = people::box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict ==
-                           people::BoxDepthVerdict::kFlat;
-      tested.emplace_back(b.box, is_flat);
-      return is_flat;
+      const auto v = people::box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict;
+      tested.emplace_back(b.box, v);
+      return v;
+    };
+    // A raw box too small to test, or undecided, takes the verdict of the NMS box it duplicates.
+    std::vector<cv::Rect2f> nms_boxes;
+    std::vector<people::BoxDepthVerdict> nms_verdicts;
+    for (const auto& b : area_boxes) {
+      nms_boxes.push_back(b.box);
+      nms_verdicts.push_back(verdict(b));
+    }
+    auto flat = [&](const people::PersonBox& b) {
+      return people::flat_by_leader(b.box, verdict(b), nms_boxes, nms_verdicts);
     };
     const size_t before = area_boxes.size();
     area_boxes.erase(std::remove_if(area_boxes.begin(), area_boxes.end(), flat), area_boxes.end());
@@ -366,8 +381,8 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   }
   out.person_boxes = static_cast<int>(area_boxes.size());
   out.keypoints_before_filter = static_cast<int>(raw.keys.size());
-  const people::FilterResult filtered = people::filter_keypoints(
-      raw.keys, boxes, filter_options_, depth_m, depth_image, depth_factor);
+  const people::FilterResult filtered =
+      people::filter_keypoints(raw.keys, boxes, filter_options_, depth_m, depth_image, depth_factor);
   if (filtered.removed > 0) {
     tracking::RawFeatures kept;
     kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));

@@ -41,16 +41,16 @@ struct PeopleStageOptions {
 
 // What the stage did to one frame (copied into the frame's report).
 struct PeopleFrame {
-  int person_boxes = 0;         // boxes of people in this frame (after NMS / confirmed tracks)
-  double people_area = 0;       // fraction of the image they cover (FeatureBudget.area)
+  int person_boxes = 0;    // boxes of people in this frame (after NMS / confirmed tracks)
+  double people_area = 0;  // fraction of the image they cover (FeatureBudget.area)
   int keypoints_before_filter = 0;
   double detector_ms = 0;       // forward time of the detection whose boxes are used (0: none new)
   double detector_wait_ms = 0;  // how long the frame waited for boxes (every_frame mode only)
   int right_keypoints_removed = 0;
-  int flat_boxes = 0;           // RGB-D: boxes with nothing standing out of their surroundings, ignored
-  int64_t detection_frame = -1;  // frame the boxes were detected on (-1: no detection yet)
+  int flat_boxes = 0;             // RGB-D: boxes with nothing standing out of their surroundings, ignored
+  int64_t detection_frame = -1;   // frame the boxes were detected on (-1: no detection yet)
   bool boxes_propagated = false;  // boxes moved here from an earlier frame by the image flow
-  std::vector<people::PersonBox> boxes;  // used for filtering
+  std::vector<people::PersonBox> boxes;         // used for filtering
   std::vector<cv::KeyPoint> removed_keypoints;  // only when recording keypoints
   // When the filter removed keypoints: per keypoint before the filter, its index after it (-1 = removed)
   // and the box that removed it (index into `boxes`, -1 = kept).
@@ -59,14 +59,14 @@ struct PeopleFrame {
 };
 
 struct PeopleStageStats {
-  std::size_t detections = 0;         // detector results used
-  std::size_t frames_detected = 0;    // frames whose boxes were detected on that very frame
-  std::size_t frames_propagated = 0;  // frames whose boxes came from an earlier frame
-  std::size_t boxes_moved = 0;        // box moves by the flow (summed over frames)
+  std::size_t detections = 0;           // detector results used
+  std::size_t frames_detected = 0;      // frames whose boxes were detected on that very frame
+  std::size_t frames_propagated = 0;    // frames whose boxes came from an earlier frame
+  std::size_t boxes_moved = 0;          // box moves by the flow (summed over frames)
   std::size_t boxes_kept_in_place = 0;  // boxes the flow could not move (too few corners)
   std::size_t tracks_started = 0;
-  std::size_t tracks_coasting = 0;    // summed over detections: confirmed tracks kept without a match
-  std::size_t flat_boxes = 0;         // boxes the depth test found flat (summed over frames, NMS level)
+  std::size_t tracks_coasting = 0;  // summed over detections: confirmed tracks kept without a match
+  std::size_t flat_boxes = 0;       // boxes the depth test found flat (summed over frames, NMS level)
   std::size_t frames_with_flat_boxes = 0;
   std::size_t raw_boxes_dropped = 0;  // raw boxes far larger than their NMS box, not used as masks
 };
@@ -95,7 +95,8 @@ class PeopleStage {
   // A detection result in the current frame's coordinates: moved from its own frame's grey image.
   void take_detection(people::WorkerResult result, const people::FlowImage& image);
   // Boxes the filter uses now, and the ones (NMS level) that say how much of the image people cover.
-  void current_boxes(std::vector<people::PersonBox>& filter_boxes, std::vector<people::PersonBox>& area_boxes) const;
+  void current_boxes(std::vector<people::PersonBox>& filter_boxes,
+                     std::vector<people::PersonBox>& area_boxes) const;
   // The raw boxes used as masks (Detector.raw_box_max_area_ratio); counts the ones left out.
   std::vector<people::PersonBox> masking_raw_boxes(const people::Detections& detections);
   void move_to(const people::FlowImage& image);
@@ -120,15 +121,15 @@ class PeopleStage {
   // the frame `current_` shows (latest mode).
   std::vector<people::FlowBox> boxes_;
   std::vector<bool> nms_;
-  std::vector<int> leader_;        // per box: the NMS box a raw box moves with (-1: moved by its own flow)
+  std::vector<int> leader_;  // per box: the NMS box a raw box moves with (-1: moved by its own flow)
   people::FlowImage current_;
-  people::FlowImage offered_;      // the frame the detector is working on (latest mode)
+  people::FlowImage offered_;  // the frame the detector is working on (latest mode)
   std::size_t offered_index_ = 0;
   bool offered_any_ = false;
   std::size_t latest_interval_ = 1;  // Detector.latest_interval
   int64_t detection_frame_ = -1;
-  double detection_ms_ = 0;        // forward time of the detection taken this frame
-  bool fresh_ = false;             // a detection was taken this frame
+  double detection_ms_ = 0;  // forward time of the detection taken this frame
+  bool fresh_ = false;       // a detection was taken this frame
   PeopleStageStats stats_;
 };
 
