@@ -158,7 +158,7 @@ TEST(BoxDepth, NoDepthIsUndecided) {
 }
 
 TEST(BoxDepth, AnUndecidedRawBoxTakesTheVerdictOfTheNmsBoxItDuplicates) {
-  const std::vector<cv::Rect2f> nms = {{100, 50, 200, 400}, {400, 50, 150, 400}};
+  const std::vector<PersonBox> nms = {{{100, 50, 200, 400}, 0.9F}, {{400, 50, 150, 400}, 0.8F}};
   const std::vector<BoxDepthVerdict> verdicts = {BoxDepthVerdict::kFlat, BoxDepthVerdict::kStandsOut};
   // Raw neighbours too small to test: the one over the poster (IoU 0.6 with the flat box) is flat, the
   // one over the person is not.

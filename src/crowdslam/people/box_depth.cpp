@@ -173,19 +173,12 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
   return test;
 }
 
-bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<cv::Rect2f>& nms_boxes,
+bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<PersonBox>& nms_boxes,
                     const std::vector<BoxDepthVerdict>& nms_verdicts) {
   if (own != BoxDepthVerdict::kUnknown) return own == BoxDepthVerdict::kFlat;
-  double best = 0.0;
-  bool leader_flat = false;
-  for (size_t k = 0; k < nms_boxes.size() && k < nms_verdicts.size(); ++k) {
-    const double iou = box_iou(box, nms_boxes[k]);
-    if (iou > best) {
-      best = iou;
-      leader_flat = nms_verdicts[k] == BoxDepthVerdict::kFlat;
-    }
-  }
-  return leader_flat;
+  const int leader = most_overlapping(box, nms_boxes);
+  return leader >= 0 && static_cast<size_t>(leader) < nms_verdicts.size() &&
+         nms_verdicts[static_cast<size_t>(leader)] == BoxDepthVerdict::kFlat;
 }
 
 }  // namespace crowdslam::people

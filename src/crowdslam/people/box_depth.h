@@ -16,6 +16,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "crowdslam/people/detector.h"
+
 namespace crowdslam::people {
 
 // The valid (non-zero) raw depths of `region` (clipped to the image), on a regular grid of about
@@ -39,7 +41,7 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
 // box decided on its own keeps its verdict; an undecided one (too small to test, no depth around it)
 // takes the verdict of the NMS box it overlaps most, the detection it duplicates (the raw neighbours of
 // a false positive on a poster are the same poster). Flat = kFlat.
-bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<cv::Rect2f>& nms_boxes,
+bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<PersonBox>& nms_boxes,
                     const std::vector<BoxDepthVerdict>& nms_verdicts);
 
 }  // namespace crowdslam::people

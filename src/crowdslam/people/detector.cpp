@@ -111,6 +111,19 @@ std::vector<PersonBox> suppress_non_maxima(const std::vector<PersonBox>& boxes, 
   return kept;
 }
 
+int most_overlapping(const cv::Rect2f& box, const std::vector<PersonBox>& candidates) {
+  double best = 0.0;
+  int index = -1;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const double iou = box_iou(box, candidates[k].box);
+    if (iou > best) {
+      best = iou;
+      index = static_cast<int>(k);
+    }
+  }
+  return index;
+}
+
 std::vector<PersonBox> raw_boxes_near_leaders(const Detections& detections, double max_area_ratio,
                                               int* dropped) {
   if (dropped != nullptr) *dropped = 0;
@@ -118,16 +131,9 @@ std::vector<PersonBox> raw_boxes_near_leaders(const Detections& detections, doub
   std::vector<PersonBox> kept;
   kept.reserve(detections.raw.size());
   for (const PersonBox& r : detections.raw) {
-    double best = 0.0;
-    double leader_area = 0.0;
-    for (const PersonBox& b : detections.boxes) {
-      const double iou = box_iou(r.box, b.box);
-      if (iou > best) {
-        best = iou;
-        leader_area = b.box.area();
-      }
-    }
-    if (best > 0 && r.box.area() <= max_area_ratio * leader_area) {
+    const int leader = most_overlapping(r.box, detections.boxes);
+    if (leader >= 0 &&
+        r.box.area() <= max_area_ratio * detections.boxes[static_cast<size_t>(leader)].box.area()) {
       kept.push_back(r);
     } else if (dropped != nullptr) {
       ++*dropped;

@@ -86,6 +86,10 @@ double box_iou(const cv::Rect2f& a, const cv::Rect2f& b);
 std::vector<PersonBox> suppress_non_maxima(const std::vector<PersonBox>& boxes, double confidence,
                                            double nms);
 
+// Index of the box in `candidates` that `box` overlaps most (by IoU), -1 when it overlaps none: for a raw
+// box, the NMS box it duplicates.
+int most_overlapping(const cv::Rect2f& box, const std::vector<PersonBox>& candidates);
+
 // The raw (before-NMS) boxes that outline the person of an NMS box: each raw box's leader is the NMS box
 // it overlaps most (by IoU); a raw box more than `max_area_ratio` times its leader's area (or overlapping
 // no NMS box) is dropped and counted in `*dropped`. A low NMS threshold (the paper's 0.1) lets a box

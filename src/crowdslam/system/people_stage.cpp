@@ -109,21 +109,18 @@ void seed_corners(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, cons
 // For raw boxes: the NMS box each one follows (the kept box it overlaps most), -1 for the kept boxes
 // themselves and for a raw box that overlaps none.
 std::vector<int> leaders_of(const std::vector<people::FlowBox>& boxes, const std::vector<bool>& nms) {
+  std::vector<people::PersonBox> kept;
+  std::vector<int> kept_index;
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    if (!nms[k]) continue;
+    kept.push_back(boxes[k].box);
+    kept_index.push_back(static_cast<int>(k));
+  }
   std::vector<int> leader(boxes.size(), -1);
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (nms[i]) continue;
-    double best = 0;
-    for (size_t k = 0; k < boxes.size(); ++k) {
-      if (!nms[k]) continue;
-      const cv::Rect2f& a = boxes[i].box.box;
-      const cv::Rect2f& b = boxes[k].box.box;
-      const double overlap = (a & b).area();
-      const double iou = overlap > 0 ? overlap / (a.area() + b.area() - overlap) : 0.0;
-      if (iou > best) {
-        best = iou;
-        leader[i] = static_cast<int>(k);
-      }
-    }
+    const int k = people::most_overlapping(boxes[i].box.box, kept);
+    if (k >= 0) leader[i] = kept_index[static_cast<size_t>(k)];
   }
   return leader;
 }
@@ -363,12 +360,9 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
       return v;
     };
     // A raw box too small to test, or undecided, takes the verdict of the NMS box it duplicates.
-    std::vector<cv::Rect2f> nms_boxes;
+    const std::vector<people::PersonBox> nms_boxes = area_boxes;
     std::vector<people::BoxDepthVerdict> nms_verdicts;
-    for (const auto& b : area_boxes) {
-      nms_boxes.push_back(b.box);
-      nms_verdicts.push_back(verdict(b));
-    }
+    for (const auto& b : nms_boxes) nms_verdicts.push_back(verdict(b));
     auto flat = [&](const people::PersonBox& b) {
       return people::flat_by_leader(b.box, verdict(b), nms_boxes, nms_verdicts);
     };
