@@ -139,6 +139,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.feature_budget.thresholds = {0.0, 0.5};
   s.feature_budget.factors = {1.0, 1.25, 3.0};
   s.output.trajectory_format = "kitti";
+  s.tracking.odometry_bridge_min_inliers = 0;
   TempDir dir;
   const std::string path = (dir / "out.yaml").string();
   write_settings(path, s);
@@ -148,6 +149,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   EXPECT_EQ(back.detector.input_width, 416);
   EXPECT_EQ(back.detector.resize, "letterbox");
   EXPECT_EQ(back.camera.k1, 0.1 + 0.2);
+  EXPECT_EQ(back.tracking.odometry_bridge_min_inliers, 0);
   // A monocular settings object without rectification also survives.
   Settings mono = load_settings(config("TUM3.yaml"), SensorKind::kMonocular);
   write_settings(path, mono);
@@ -172,6 +174,7 @@ TEST(Settings, OwnSectionsTakeDefaultsWhenAbsent) {
   EXPECT_DOUBLE_EQ(s.people_filter.margin_px, 5.0);
   EXPECT_EQ(s.feature_budget.factors.size(), 6u);
   EXPECT_EQ(s.output.trajectory_format, "tum");
+  EXPECT_EQ(s.tracking.odometry_bridge_min_inliers, 50);
 }
 
 TEST(Settings, FeatureBudgetFactorTable) {
@@ -289,6 +292,10 @@ INSTANTIATE_TEST_SUITE_P(
                  "PeopleFilter.static_check_below: must be >= 0"},
         BadValue{"PeopleFilter.static_in_boxes", "PeopleFilter.static_in_boxes: \"sometimes\"",
                  "PeopleFilter.static_in_boxes: must be \"monocular\", \"always\" or \"never\""},
+        BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.odometry_bridge_min_inliers: -1",
+                 "Tracking.odometry_bridge_min_inliers: must be >= 0 (0 = off)"},
+        BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.odometry_bridge_min_inliers: 1.5",
+                 "Tracking.odometry_bridge_min_inliers: expected an integer"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: [ 0.0, 0.6, 0.3, 0.9, 0.95 ]",
                  "FeatureBudget.thresholds: must be strictly increasing"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: 0.5",

@@ -157,7 +157,7 @@ TEST(BoxDepth, NoDepthIsUndecided) {
             BoxDepthVerdict::kUnknown);
 }
 
-TEST(BoxDepth, AnUndecidedRawBoxTakesTheVerdictOfTheNmsBoxItDuplicates) {
+TEST(BoxDepth, ARawBoxIsFlatWhenItOrTheNmsBoxItDuplicatesIsFlat) {
   const std::vector<PersonBox> nms = {{{100, 50, 200, 400}, 0.9F}, {{400, 50, 150, 400}, 0.8F}};
   const std::vector<BoxDepthVerdict> verdicts = {BoxDepthVerdict::kFlat, BoxDepthVerdict::kStandsOut};
   // Raw neighbours too small to test: the one over the poster (IoU 0.6 with the flat box) is flat, the
@@ -167,9 +167,11 @@ TEST(BoxDepth, AnUndecidedRawBoxTakesTheVerdictOfTheNmsBoxItDuplicates) {
   // Overlapping both, it follows the one it overlaps most (IoU 0.37 with the person's box, 0.05 with the
   // poster).
   EXPECT_FALSE(flat_by_leader({280, 50, 220, 400}, BoxDepthVerdict::kUnknown, nms, verdicts));
-  // A box decided on its own keeps its verdict, whatever its leader's.
-  EXPECT_FALSE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kStandsOut, nms, verdicts));
+  // Found flat on its own, it is flat whatever its leader; standing out on its own, it still follows a
+  // flat leader (a wider box of the same false positive reaching other surfaces), not a standing one.
   EXPECT_TRUE(flat_by_leader({410, 60, 130, 380}, BoxDepthVerdict::kFlat, nms, verdicts));
+  EXPECT_TRUE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kStandsOut, nms, verdicts));
+  EXPECT_FALSE(flat_by_leader({410, 60, 130, 380}, BoxDepthVerdict::kStandsOut, nms, verdicts));
   // No NMS box it overlaps, or none at all: not flat.
   EXPECT_FALSE(flat_by_leader({600, 0, 30, 30}, BoxDepthVerdict::kUnknown, nms, verdicts));
   EXPECT_FALSE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kUnknown, {}, {}));

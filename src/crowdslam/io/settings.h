@@ -128,6 +128,13 @@ struct GeometrySettings {
   int free_space_cull_run = 2;
 };
 
+// Tracking through views the map does not cover (tracking/tracker.h, TrackerOptions).
+struct TrackingSettings {
+  // RGB-D / stereo: inliers among the last frame's points, its depth points included, that let the
+  // motion model track a frame seeing too few map points, and make it a keyframe (0 = off).
+  int odometry_bridge_min_inliers = 50;
+};
+
 struct FeatureBudgetSettings {
   bool enabled = true;
   std::vector<double> thresholds{0.0, 0.3, 0.6, 0.9, 0.95};
@@ -152,6 +159,7 @@ struct Settings {
   DetectorSettings detector;
   PeopleFilterSettings people_filter;
   GeometrySettings geometry;
+  TrackingSettings tracking;
   FeatureBudgetSettings feature_budget;
   OutputSettings output;
   // Which camera the file describes, whatever sensor it was loaded for: DepthMapFactor present = an

@@ -224,6 +224,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
             g.free_space_ratio);
   c.require(g.free_space_cull_run >= 1 && g.free_space_cull_run <= 8, "Geometry.free_space_cull_run",
             "in [1, 8]", g.free_space_cull_run);
+  c.require(s.tracking.odometry_bridge_min_inliers >= 0, "Tracking.odometry_bridge_min_inliers", ">= 0 (0 = off)",
+            s.tracking.odometry_bridge_min_inliers);
   const auto& b = s.feature_budget;
   if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
   for (std::size_t i = 0; i < b.thresholds.size(); ++i) {

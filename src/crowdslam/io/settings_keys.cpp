@@ -78,6 +78,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Geometry.free_space_margin_m",
                                   "Geometry.free_space_ratio",
                                   "Geometry.free_space_cull_run",
+                                  "Tracking.odometry_bridge_min_inliers",
                                   "FeatureBudget.enabled",
                                   "FeatureBudget.thresholds",
                                   "FeatureBudget.factors",

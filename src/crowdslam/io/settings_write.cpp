@@ -121,6 +121,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nGeometry.free_space_margin_m: " << real_text(g.free_space_margin_m)
       << "\nGeometry.free_space_ratio: " << real_text(g.free_space_ratio)
       << "\nGeometry.free_space_cull_run: " << g.free_space_cull_run << "\n\n";
+  out << "# Tracking through views the map does not cover (RGB-D / stereo)\nTracking.odometry_bridge_min_inliers: "
+      << s.tracking.odometry_bridge_min_inliers << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "

@@ -175,7 +175,7 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
 
 bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<PersonBox>& nms_boxes,
                     const std::vector<BoxDepthVerdict>& nms_verdicts) {
-  if (own != BoxDepthVerdict::kUnknown) return own == BoxDepthVerdict::kFlat;
+  if (own == BoxDepthVerdict::kFlat) return true;
   const int leader = most_overlapping(box, nms_boxes);
   return leader >= 0 && static_cast<size_t>(leader) < nms_verdicts.size() &&
          nms_verdicts[static_cast<size_t>(leader)] == BoxDepthVerdict::kFlat;

@@ -37,10 +37,12 @@ struct BoxDepthTest {
 BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
                             double margin_m);
 
-// Whether a raw (before-NMS) box is flat given its own verdict (`own`) and the NMS boxes with theirs: a
-// box decided on its own keeps its verdict; an undecided one (too small to test, no depth around it)
-// takes the verdict of the NMS box it overlaps most, the detection it duplicates (the raw neighbours of
-// a false positive on a poster are the same poster). Flat = kFlat.
+// Whether a raw (before-NMS) box is flat given its own verdict (`own`) and the NMS boxes with theirs: it
+// is flat when it is found flat itself or when the NMS box it overlaps most, the detection it
+// duplicates, is (the raw neighbours of a false positive on a poster are the same false positive). A
+// wider raw box of a false positive often spans other surfaces too and then stands out on its own: in
+// the synthetic stereo false-positive room such boxes covered 60-90 % of the image after their NMS box
+// was found flat, and tracking was lost (docs/CROWDS.md). Flat = kFlat.
 bool flat_by_leader(const cv::Rect2f& box, BoxDepthVerdict own, const std::vector<PersonBox>& nms_boxes,
                     const std::vector<BoxDepthVerdict>& nms_verdicts);
 

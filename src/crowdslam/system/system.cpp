@@ -82,6 +82,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
     // partner (measured on EuRoC and the synthetic sequences), so ask for that many points with depth.
     tracker_options.min_init_features = 250;
   }
+  tracker_options.odometry_bridge_min_inliers = settings.tracking.odometry_bridge_min_inliers;
   const io::GeometrySettings& g = settings.geometry;
   tracker_options.dynamic.enabled = g.dynamic_check;
   tracker_options.dynamic.moving_factor = g.moving_factor;

@@ -97,6 +97,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     if (last_frame_) replace_replaced_points(*last_frame_);
     // The dynamic check must never be the reason tracking fails: keep the frame as it came for a retry.
     std::optional<map::Frame> untouched;
+    bool bridged = false;
+    odometry_bridge_.reset();
     if (dynamic_check_.enabled() && was_tracking) untouched = frame;
     if (state_ == TrackingState::kOk && velocity_ && last_frame_) {
       ok = track_with_motion_model(frame);
@@ -137,6 +139,17 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
         ok = true;
       }
     }
+    if (!ok && odometry_bridge_) {
+      // The map does not cover what this frame sees, but the last frame's depth points place it: track on
+      // and make it a keyframe (below), so the next frame has map points here.
+      frame = std::move(*odometry_bridge_);
+      frame.reference_keyframe = reference_keyframe_;
+      track_local_map(frame);  // adds the map points it can see; the odometry inliers carry the pose
+      ok = true;
+      bridged = true;
+      result.method = "odometry";
+    }
+    odometry_bridge_.reset();
     if (!ok && boxes && options_.box_keypoints && !was_tracking) {
       // Lost, and the filter left too little to relocalise: the whole image may still show the map.
       if (auto full = relocalize_with_box_keypoints(frame, boxes)) {
@@ -168,6 +181,10 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       lost_frames_ = 0;
       if (last_frame_ && last_frame_->cam_from_world) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
+      } else if (!options_.monocular) {
+        // Relocalised after lost frames: the next frame is looked for near this pose (no velocity known),
+        // so the motion model and its depth points can take it.
+        velocity_ = geometry::SE3();
       } else {
         velocity_.reset();
       }
@@ -177,6 +194,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       }
       temporal_points_.clear();
       KeyframeDecision decision = localization_only_ ? KeyframeDecision::kNo : need_new_keyframe(frame);
+      if (bridged && !localization_only_ && !mapper_->is_paused()) decision = KeyframeDecision::kInsert;
       if (decision == KeyframeDecision::kWaitForMapper) {
         // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
         // mapper can write its bundle adjustment back) rather than track on without new points.
@@ -371,8 +389,13 @@ bool Tracker::track_with_motion_model(map::Frame& frame) {
     matches = match::search_from_last_frame(frame, *last_frame_, 2 * options_.motion_model_radius);
   }
   if (matches < 20) return false;
-  optimize_pose(frame);
-  return discard_outliers_count_map_points(frame) >= 10;
+  const int inliers = optimize_pose(frame);
+  const int in_map = discard_outliers_count_map_points(frame);
+  if (in_map < 10 && !options_.monocular && options_.odometry_bridge_min_inliers > 0 &&
+      inliers >= options_.odometry_bridge_min_inliers) {
+    odometry_bridge_ = frame;
+  }
+  return in_map >= 10;
 }
 
 bool Tracker::track_reference_keyframe(map::Frame& frame) {

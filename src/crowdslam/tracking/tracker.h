@@ -64,6 +64,12 @@ struct TrackerOptions {
   // map does not cover; a new map tracks it from here on, and the old map's poses stay in the outputs as
   // their own segment. Never with a loaded map. Usually one second of frames.
   int new_map_after_lost_frames = 30;
+  // RGB-D / stereo: a frame the motion model places with at least this many inliers among the last
+  // frame's points, its depth points (visual odometry) included, is tracked even when it sees too few
+  // map points for the local map, and becomes a keyframe at once, so the map gets points where the camera
+  // is (method "odometry"). People covering the mapped part of the view, or the camera turning to walls
+  // the map has not seen, otherwise lose a camera whose motion is well measured (0 = off).
+  int odometry_bridge_min_inliers = 50;
   // Keypoints in person boxes (Tracker::track, BoxKeypoints): taken back for the pose when the filtered
   // frame tracks fewer than box_check_below points or fails, if they match map points seen at least
   // box_min_observations times (a depth observation counts twice) and judged moving at most once in
@@ -94,7 +100,8 @@ struct TrackResult {
   bool map_reset = false;
   int tracked_points = 0;  // inliers after local-map tracking
   int keypoints = 0;
-  const char* method = "";  // "init", "motion", "reference", "relocalization", "motion+boxes", "lost"
+  // "init", "motion", "reference", "relocalization", "motion+boxes", "odometry", "lost"
+  const char* method = "";
   int box_matches = 0;      // keypoints in person boxes among the tracked points (BoxKeypoints)
   int static_boxes = 0;  // boxes whose keypoints the static map vouched for (released, see box_keypoints.cpp)
   // The filtered frame failed and the keypoints in boxes tracked it (method "motion+boxes").
@@ -208,6 +215,9 @@ class Tracker {
   bool map_loaded_ = false;
   bool localization_only_ = false;
   std::vector<std::shared_ptr<map::MapPoint>> temporal_points_;  // visual-odometry points of the last frame
+  // This frame as the motion model placed it, when only the last frame's depth points held it
+  // (odometry_bridge_min_inliers); taken if nothing else tracks the frame.
+  std::optional<map::Frame> odometry_bridge_;
   std::optional<map::Frame> last_box_frame_;                     // remember_box_frame
   std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
   std::vector<std::shared_ptr<map::MapPoint>> local_points_;
