@@ -124,14 +124,15 @@ void KeyFrame::update_connections() {
   std::map<uint64_t, std::pair<std::shared_ptr<KeyFrame>, int>> counter;
   for (const auto& point : map_points()) {
     if (!point || point->is_bad()) continue;
-    for (const auto& [kf_id, obs] : point->observations()) {
-      if (kf_id == id) continue;
-      auto kf = obs.keyframe.lock();
-      if (!kf || kf->is_bad()) continue;
+    point->for_each_observation([&](uint64_t kf_id, const MapPoint::Observation& obs) {
+      if (kf_id == id) return;
       auto& entry = counter[kf_id];
-      entry.first = kf;
+      if (!entry.first) entry.first = obs.keyframe.lock();
       ++entry.second;
-    }
+    });
+  }
+  for (auto it = counter.begin(); it != counter.end();) {  // keyframes gone or bad
+    it = it->second.first && !it->second.first->is_bad() ? std::next(it) : counter.erase(it);
   }
   if (counter.empty()) return;
 

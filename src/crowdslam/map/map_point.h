@@ -45,6 +45,14 @@ class MapPoint {
   // When two or fewer observations remain the point is set bad (and so unlinked from its keyframes).
   void erase_observation(uint64_t keyframe_id);
   [[nodiscard]] std::map<uint64_t, Observation> observations() const;
+  // Calls visit(keyframe_id, observation) for each observation under the point's lock, without copying
+  // them (the hot loops of tracking and local mapping). `visit` must not call back into this point; it
+  // may read the observing keyframe's immutable data and its atomic flags, nothing that takes a lock.
+  template <class Visit>
+  void for_each_observation(Visit&& visit) const {
+    std::lock_guard lock(features_mutex_);
+    for (const auto& [keyframe_id, observation] : observations_) visit(keyframe_id, observation);
+  }
   [[nodiscard]] int num_observations() const;  // a stereo/RGB-D observation counts twice (ORB-SLAM)
   [[nodiscard]] bool is_observed_by(uint64_t keyframe_id) const;
   [[nodiscard]] long index_in(uint64_t keyframe_id) const;  // -1 if not observed

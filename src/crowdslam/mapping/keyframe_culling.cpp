@@ -22,14 +22,11 @@ void LocalMapper::cull_keyframes(const std::shared_ptr<map::KeyFrame>& keyframe)
       if (point->num_observations() <= kOtherObservers) continue;
       const int level = f.keys_un[i].octave;
       int observers = 0;
-      for (const auto& [kf_id, obs] : point->observations()) {
-        if (kf_id == candidate->id) continue;
+      point->for_each_observation([&](uint64_t kf_id, const map::MapPoint::Observation& obs) {
+        if (kf_id == candidate->id || observers >= kOtherObservers) return;
         auto other = obs.keyframe.lock();
-        if (!other) continue;
-        if (other->features->keys_un[obs.index].octave <= level + 1) {
-          if (++observers >= kOtherObservers) break;
-        }
-      }
+        if (other && other->features->keys_un[obs.index].octave <= level + 1) ++observers;
+      });
       if (observers >= kOtherObservers) ++redundant;
     }
     if (total > 0 && redundant > options_.redundancy_ratio * total) {

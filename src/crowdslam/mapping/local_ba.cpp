@@ -33,9 +33,9 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
   {
     std::unordered_map<uint64_t, int> seen_points;
     for (const auto& point : points) {
-      for (const auto& [kf_id, obs] : point->observations()) {
+      point->for_each_observation([&](uint64_t kf_id, const map::MapPoint::Observation&) {
         if (!local_ids.count(kf_id)) ++seen_points[kf_id];
-      }
+      });
     }
     std::vector<std::pair<int, uint64_t>> by_count;
     for (const auto& [kf_id, count] : seen_points) by_count.emplace_back(count, kf_id);
@@ -57,10 +57,10 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
   for (size_t k = 0; k < points.size(); ++k) {
     const auto& point = points[k];
     ba_points.push_back({static_cast<int>(k), point->world()});
-    for (const auto& [kf_id, obs] : point->observations()) {
-      if (!local_ids.count(kf_id) && !fixed_ids.count(kf_id)) continue;
+    point->for_each_observation([&](uint64_t kf_id, const map::MapPoint::Observation& obs) {
+      if (!local_ids.count(kf_id) && !fixed_ids.count(kf_id)) return;
       auto kf = obs.keyframe.lock();
-      if (!kf || kf->is_bad()) continue;
+      if (!kf || kf->is_bad()) return;
       all_keyframes.emplace(kf_id, kf);  // fixed if not local
       const auto& f = *kf->features;
       optim::BaObservation o;
@@ -70,8 +70,8 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
       o.right_u = f.right_u[obs.index];
       o.inv_sigma2 = kf->levels->inv_sigma2[f.keys_un[obs.index].octave];
       observations.push_back(o);
-      links.push_back({kf, point, obs.index});
-    }
+      links.push_back({std::move(kf), point, obs.index});
+    });
   }
   std::vector<optim::BaKeyframe> ba_keyframes;
   std::vector<std::shared_ptr<map::KeyFrame>> ba_keyframe_refs;

@@ -166,14 +166,18 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
         const double weight = huber_weight(r.squaredNorm(), o.huber_delta);
         const Mat3 d = problem.d_residual(o, p_cam);
         const Mat3 j_point = d * rotations[o.pose];
-        v[o.point].noalias() += weight * j_point.transpose() * j_point;
-        g_point[o.point].noalias() += weight * j_point.transpose() * r;
+        // The weighted transposes first: products of plain fixed-size matrices (a scalar inside a lazy
+        // product made Eigen evaluate these coefficient by coefficient, 5 % of a run's instructions).
+        const Mat3 j_point_tw = weight * j_point.transpose();
+        v[o.point].noalias() += j_point_tw * j_point;
+        g_point[o.point].noalias() += j_point_tw * r;
         const int f = free_index[o.pose];
         if (f < 0) continue;
         const Eigen::Matrix<double, 3, 6> j_pose = d * point_jacobian_wrt_pose(p_cam);
-        u[f].noalias() += weight * j_pose.transpose() * j_pose;
-        g_pose[f].noalias() += weight * j_pose.transpose() * r;
-        w[i].noalias() = weight * j_pose.transpose() * j_point;
+        const Mat63 j_pose_tw = weight * j_pose.transpose();
+        u[f].noalias() += j_pose_tw * j_pose;
+        g_pose[f].noalias() += j_pose_tw * r;
+        w[i].noalias() = j_pose_tw * j_point;
       }
       linearize = false;
     }

@@ -421,13 +421,14 @@ void Tracker::update_local_map(const map::Frame& frame) {
   std::unordered_map<uint64_t, std::pair<std::shared_ptr<map::KeyFrame>, int>> counter;
   for (const auto& p : frame.map_points) {
     if (!p || p->is_bad()) continue;
-    for (const auto& [kf_id, obs] : p->observations()) {
-      auto kf = obs.keyframe.lock();
-      if (!kf) continue;
+    p->for_each_observation([&](uint64_t kf_id, const map::MapPoint::Observation& obs) {
       auto& entry = counter[kf_id];
-      entry.first = std::move(kf);
+      if (!entry.first) entry.first = obs.keyframe.lock();
       ++entry.second;
-    }
+    });
+  }
+  for (auto it = counter.begin(); it != counter.end();) {  // keyframes already gone
+    it = it->second.first ? std::next(it) : counter.erase(it);
   }
   if (counter.empty()) return;
   local_keyframes_.clear();
