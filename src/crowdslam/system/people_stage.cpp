@@ -359,7 +359,8 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
       tested.emplace_back(b.box, v);
       return v;
     };
-    // A raw box too small to test, or undecided, takes the verdict of the NMS box it duplicates.
+    // A raw box is flat when it is found flat itself or when the NMS box it duplicates is
+    // (people::flat_by_leader).
     const std::vector<people::PersonBox> nms_boxes = area_boxes;
     std::vector<people::BoxDepthVerdict> nms_verdicts;
     for (const auto& b : nms_boxes) nms_verdicts.push_back(verdict(b));

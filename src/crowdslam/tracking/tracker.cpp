@@ -193,8 +193,10 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
         if (p && p->num_observations() < 1) p.reset();
       }
       temporal_points_.clear();
-      KeyframeDecision decision = localization_only_ ? KeyframeDecision::kNo : need_new_keyframe(frame);
-      if (bridged && !localization_only_ && !mapper_->is_paused()) decision = KeyframeDecision::kInsert;
+      // A bridged frame is a keyframe whenever one can be made: the map has no points where it looks.
+      KeyframeDecision decision = localization_only_                    ? KeyframeDecision::kNo
+                                  : bridged && !mapper_->is_paused() ? KeyframeDecision::kInsert
+                                                                     : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
         // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
         // mapper can write its bundle adjustment back) rather than track on without new points.
