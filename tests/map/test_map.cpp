@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "crowdslam/map/keyframe.h"
@@ -209,6 +210,77 @@ TEST(MapPoint, NormalAndScaleRange) {
   EXPECT_NEAR(p->min_distance(), 0.8 * 4.0 / std::pow(1.2, 7), 1e-4);
   EXPECT_EQ(p->predict_scale(4.0f, *t.levels), 0);
   EXPECT_EQ(p->predict_scale(4.0f / 1.2f / 1.2f, *t.levels), 2);
+}
+
+TEST(MapPoint, ViewGeometryIsTheSingleAccessorsUnderOneLock) {
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe();
+  auto p = t.add_point({a, b}, 3);
+  p->set_world(a->camera_center() + geometry::Vec3(0.3, -0.2, 3.5));
+  p->update_normal_and_depth();
+  const MapPoint::ViewGeometry view = p->view_geometry();
+  EXPECT_EQ(view.world, p->world());
+  EXPECT_EQ(view.normal, p->normal());
+  EXPECT_EQ(view.min_distance, p->min_distance());
+  EXPECT_EQ(view.max_distance, p->max_distance());
+  for (float d : {0.05f, 0.5f, 1.0f, 2.9f, 3.5f, 4.2f, 9.0f}) {
+    EXPECT_EQ(view.predict_scale(d, *t.levels), p->predict_scale(d, *t.levels)) << d;
+  }
+}
+
+TEST(MapPoint, ObservationsStayOrderedByKeyframeIdWhateverTheInsertionOrder) {
+  TestMap t;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (int i = 0; i < 7; ++i) kfs.push_back(t.add_keyframe());
+  auto p = std::make_shared<MapPoint>(t.map.next_map_point_id(), geometry::Vec3(0, 0, 2), kfs[3], 0);
+  for (int i : {3, 6, 0, 5, 1, 4, 2}) p->add_observation(kfs[i], 10 + i);
+  p->add_observation(kfs[5], 99);  // a second observation by the same keyframe is ignored
+  EXPECT_EQ(p->index_in(kfs[5]->id), 15);
+  p->erase_observation(kfs[4]->id);
+  p->erase_observation(kfs[4]->id);  // erasing twice is harmless
+  std::vector<uint64_t> visited;
+  p->for_each_observation([&](uint64_t id, const MapPoint::Observation& o) {
+    visited.push_back(id);
+    EXPECT_EQ(o.index, 10 + id - kfs[0]->id);
+  });
+  EXPECT_EQ(visited,
+            (std::vector<uint64_t>{kfs[0]->id, kfs[1]->id, kfs[2]->id, kfs[3]->id, kfs[5]->id, kfs[6]->id}));
+  const auto copy = p->observations();
+  ASSERT_EQ(copy.size(), 6u);
+  EXPECT_TRUE(std::is_sorted(copy.begin(), copy.end(),
+                             [](const auto& x, const auto& y) { return x.first < y.first; }));
+  EXPECT_FALSE(p->is_observed_by(kfs[4]->id));
+  EXPECT_EQ(p->index_in(kfs[4]->id), -1);
+  EXPECT_TRUE(p->is_observed_by(kfs[6]->id));
+  // The reference keyframe (kfs[3]) erased: the one with the smallest id takes over.
+  p->erase_observation(kfs[3]->id);
+  EXPECT_EQ(p->reference_keyframe(), kfs[0]);
+}
+
+TEST(MapPoint, MarksTellEachPassWhichPointsItHasSeen) {
+  TestMap t;
+  auto a = t.add_keyframe(), b = t.add_keyframe();
+  auto p = t.add_point({a, b}, 1);
+  auto q = t.add_point({a, b}, 2);
+  const uint64_t first = MapPoint::next_mark();
+  const uint64_t second = MapPoint::next_mark();
+  EXPECT_NE(first, second);
+  EXPECT_NE(first, 0u);  // a new point carries mark 0, which no pass has
+  EXPECT_TRUE(p->mark(first));
+  EXPECT_FALSE(p->mark(first));  // seen already in this pass
+  EXPECT_TRUE(p->marked(first));
+  EXPECT_FALSE(q->marked(first));
+  EXPECT_TRUE(p->mark(second));  // a new pass starts afresh
+  EXPECT_FALSE(p->marked(first));
+  // A keyframe's points visited in place: each non-null slot once.
+  size_t visited = 0;
+  a->for_each_map_point([&](const std::shared_ptr<MapPoint>& point) {
+    EXPECT_TRUE(point == p || point == q);
+    ++visited;
+  });
+  EXPECT_EQ(visited, 2u);
+  q->set_bad();
+  EXPECT_EQ(a->valid_map_points(), (std::vector<std::shared_ptr<MapPoint>>{p}));
 }
 
 TEST(MapPoint, ReplaceMovesObservations) {

@@ -18,7 +18,8 @@ Frame::Frame(uint64_t id_in, double timestamp_s_in, std::shared_ptr<const geomet
       in_box(features->size(), false) {}
 
 std::optional<PointProjection> Frame::project(const MapPoint& point, double min_view_cos) const {
-  const geometry::Vec3 world = point.world();
+  const MapPoint::ViewGeometry view = point.view_geometry();
+  const geometry::Vec3& world = view.world;
   const geometry::Vec3 in_cam = *cam_from_world * world;
   if (in_cam.z() <= 0) return std::nullopt;
   const geometry::Vec2 pixel = camera->project(in_cam);
@@ -26,8 +27,8 @@ std::optional<PointProjection> Frame::project(const MapPoint& point, double min_
 
   const geometry::Vec3 ray = world - camera_center();
   const double distance = ray.norm();
-  if (distance < point.min_distance() || distance > point.max_distance()) return std::nullopt;
-  const double view_cos = ray.dot(point.normal()) / distance;
+  if (distance < view.min_distance || distance > view.max_distance) return std::nullopt;
+  const double view_cos = ray.dot(view.normal) / distance;
   if (view_cos < min_view_cos) return std::nullopt;
 
   PointProjection p;
@@ -36,7 +37,7 @@ std::optional<PointProjection> Frame::project(const MapPoint& point, double min_
   p.right_u = camera->is_stereo() ? pixel.x() - camera->bf / in_cam.z() : -1.0;
   p.distance = distance;
   p.view_cos = view_cos;
-  p.predicted_level = point.predict_scale(static_cast<float>(distance), *levels);
+  p.predicted_level = view.predict_scale(static_cast<float>(distance), *levels);
   return p;
 }
 

@@ -71,11 +71,11 @@ std::vector<std::shared_ptr<MapPoint>> KeyFrame::map_points() const {
 }
 
 std::vector<std::shared_ptr<MapPoint>> KeyFrame::valid_map_points() const {
-  std::vector<std::shared_ptr<MapPoint>> all = map_points();
   std::vector<std::shared_ptr<MapPoint>> result;
-  result.reserve(all.size());
-  for (auto& p : all) {
-    if (p && !p->is_bad()) result.push_back(std::move(p));
+  std::lock_guard lock(features_mutex_);
+  result.reserve(map_points_.size());
+  for (const auto& p : map_points_) {
+    if (p && !p->is_bad()) result.push_back(p);
   }
   return result;
 }
@@ -121,18 +121,25 @@ void KeyFrame::erase_connection(uint64_t other_id) {
 
 void KeyFrame::update_connections() {
   constexpr int kEdgeThreshold = 15;
-  std::map<uint64_t, std::pair<std::shared_ptr<KeyFrame>, int>> counter;
-  for (const auto& point : map_points()) {
+  // Shared points per other keyframe: every observation's keyframe id collected, sorted and counted in
+  // runs (ascending ids, as a std::map counter gave them, without a tree lookup per observation).
+  std::vector<std::pair<uint64_t, std::weak_ptr<KeyFrame>>> seen;
+  const auto points = map_points();
+  seen.reserve(points.size() * 4);
+  for (const auto& point : points) {
     if (!point || point->is_bad()) continue;
     point->for_each_observation([&](uint64_t kf_id, const MapPoint::Observation& obs) {
-      if (kf_id == id) return;
-      auto& entry = counter[kf_id];
-      if (!entry.first) entry.first = obs.keyframe.lock();
-      ++entry.second;
+      if (kf_id != id) seen.emplace_back(kf_id, obs.keyframe);
     });
   }
-  for (auto it = counter.begin(); it != counter.end();) {  // keyframes gone or bad
-    it = it->second.first && !it->second.first->is_bad() ? std::next(it) : counter.erase(it);
+  std::sort(seen.begin(), seen.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::pair<uint64_t, std::pair<std::shared_ptr<KeyFrame>, int>>> counter;
+  for (size_t i = 0; i < seen.size();) {
+    size_t j = i;
+    while (j < seen.size() && seen[j].first == seen[i].first) ++j;
+    auto kf = seen[i].second.lock();  // keyframes gone or bad are not counted
+    if (kf && !kf->is_bad()) counter.push_back({seen[i].first, {std::move(kf), static_cast<int>(j - i)}});
+    i = j;
   }
   if (counter.empty()) return;
 

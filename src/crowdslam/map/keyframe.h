@@ -47,6 +47,16 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   [[nodiscard]] std::shared_ptr<MapPoint> map_point(size_t index) const;
   [[nodiscard]] std::vector<std::shared_ptr<MapPoint>> map_points() const;        // copy, with nulls
   [[nodiscard]] std::vector<std::shared_ptr<MapPoint>> valid_map_points() const;  // non-null, not bad
+  // Calls visit(point) for each non-null slot under the keyframe's lock, without copying the list (the
+  // local map of tracking: ~10^4 points per frame). `visit` must take no lock (a point's atomics, such as
+  // is_bad() and mark(), are fine) and must not call back into this keyframe.
+  template <class Visit>
+  void for_each_map_point(Visit&& visit) const {
+    std::lock_guard lock(features_mutex_);
+    for (const auto& point : map_points_) {
+      if (point) visit(point);
+    }
+  }
   // Number of good points with at least `min_observations` observations.
   [[nodiscard]] int tracked_map_points(int min_observations) const;
   // Number of good points that tracking has matched in at least `min_found` frames (MapPoint::found_count).

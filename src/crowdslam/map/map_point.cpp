@@ -17,6 +17,11 @@ MapPoint::MapPoint(uint64_t id_in, const geometry::Vec3& world,
       world_(world),
       reference_keyframe_(reference_keyframe) {}
 
+uint64_t MapPoint::next_mark() {
+  static std::atomic<uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+
 geometry::Vec3 MapPoint::world() const {
   std::lock_guard lock(position_mutex_);
   return world_;
@@ -43,19 +48,54 @@ float MapPoint::max_distance() const {
 }
 
 int MapPoint::predict_scale(float distance, const ScaleLevels& levels) const {
-  float ratio = 0;
+  ViewGeometry geometry;
   {
     std::lock_guard lock(position_mutex_);
-    ratio = max_distance_ / std::max(distance, 1e-6f);
+    geometry.scale_distance = max_distance_;
   }
-  int level = static_cast<int>(std::ceil(std::log(ratio) / levels.log_scale_factor));
+  return geometry.predict_scale(distance, levels);
+}
+
+int MapPoint::ViewGeometry::predict_scale(float distance, const ScaleLevels& levels) const {
+  const float ratio = scale_distance / std::max(distance, 1e-6f);
+  const int level = static_cast<int>(std::ceil(std::log(ratio) / levels.log_scale_factor));
   return std::clamp(level, 0, levels.num_levels - 1);
+}
+
+MapPoint::ViewGeometry MapPoint::view_geometry() const {
+  std::lock_guard lock(position_mutex_);
+  ViewGeometry geometry;
+  geometry.world = world_;
+  geometry.normal = normal_;
+  geometry.min_distance = 0.8f * min_distance_;
+  geometry.max_distance = 1.2f * max_distance_;
+  geometry.scale_distance = max_distance_;
+  return geometry;
+}
+
+namespace {
+template <class It>
+It lower_bound_id(It begin, It end, uint64_t keyframe_id) {
+  return std::lower_bound(begin, end, keyframe_id,
+                          [](const auto& entry, uint64_t id) { return entry.first < id; });
+}
+}  // namespace
+
+MapPoint::Observations::iterator MapPoint::find_observation(uint64_t keyframe_id) {
+  auto it = lower_bound_id(observations_.begin(), observations_.end(), keyframe_id);
+  return it != observations_.end() && it->first == keyframe_id ? it : observations_.end();
+}
+
+MapPoint::Observations::const_iterator MapPoint::find_observation(uint64_t keyframe_id) const {
+  auto it = lower_bound_id(observations_.cbegin(), observations_.cend(), keyframe_id);
+  return it != observations_.cend() && it->first == keyframe_id ? it : observations_.cend();
 }
 
 void MapPoint::add_observation(const std::shared_ptr<KeyFrame>& keyframe, size_t index) {
   std::lock_guard lock(features_mutex_);
-  if (observations_.count(keyframe->id)) return;
-  observations_[keyframe->id] = {keyframe, index};
+  auto it = lower_bound_id(observations_.begin(), observations_.end(), keyframe->id);
+  if (it != observations_.end() && it->first == keyframe->id) return;
+  observations_.insert(it, {keyframe->id, Observation{keyframe, index}});
   num_observations_ += keyframe->features->has_right(index) ? 2 : 1;
 }
 
@@ -63,7 +103,7 @@ void MapPoint::erase_observation(uint64_t keyframe_id) {
   bool now_bad = false;
   {
     std::lock_guard lock(features_mutex_);
-    auto it = observations_.find(keyframe_id);
+    auto it = find_observation(keyframe_id);
     if (it == observations_.end()) return;
     auto kf = it->second.keyframe.lock();
     const bool stereo = kf && kf->features->has_right(it->second.index);
@@ -78,7 +118,7 @@ void MapPoint::erase_observation(uint64_t keyframe_id) {
   if (now_bad) set_bad();
 }
 
-std::map<uint64_t, MapPoint::Observation> MapPoint::observations() const {
+MapPoint::Observations MapPoint::observations() const {
   std::lock_guard lock(features_mutex_);
   return observations_;
 }
@@ -90,12 +130,12 @@ int MapPoint::num_observations() const {
 
 bool MapPoint::is_observed_by(uint64_t keyframe_id) const {
   std::lock_guard lock(features_mutex_);
-  return observations_.count(keyframe_id) > 0;
+  return find_observation(keyframe_id) != observations_.end();
 }
 
 long MapPoint::index_in(uint64_t keyframe_id) const {
   std::lock_guard lock(features_mutex_);
-  auto it = observations_.find(keyframe_id);
+  auto it = find_observation(keyframe_id);
   return it == observations_.end() ? -1 : static_cast<long>(it->second.index);
 }
 
@@ -228,7 +268,7 @@ int MapPoint::found_count() const { return found_.load(std::memory_order_relaxed
 bool MapPoint::is_bad() const { return bad_.load(std::memory_order_acquire); }
 
 void MapPoint::set_bad() {
-  std::map<uint64_t, Observation> obs;
+  Observations obs;
   {
     std::lock_guard lock(features_mutex_);
     if (bad_) return;
@@ -247,7 +287,7 @@ void MapPoint::set_bad() {
 
 void MapPoint::replace(const std::shared_ptr<MapPoint>& other) {
   if (!other || other.get() == this) return;
-  std::map<uint64_t, Observation> obs;
+  Observations obs;
   int visible = 0;
   int found = 0;
   {

@@ -4,9 +4,10 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <mutex>
+#include <utility>
+#include <vector>
 
 #include "crowdslam/geometry/se3.h"
 #include "crowdslam/map/scale_levels.h"
@@ -23,6 +24,10 @@ class MapPoint {
     std::weak_ptr<KeyFrame> keyframe;
     size_t index = 0;  // keypoint index in that keyframe
   };
+  // (keyframe id, observation) sorted by keyframe id: a flat array, not a tree. A point has a few to a
+  // few dozen observations, and tracking and local mapping walk them for every local point; a
+  // std::map's node hopping was 5 % of the CPU of a bonn_crowd run.
+  using Observations = std::vector<std::pair<uint64_t, Observation>>;
 
   MapPoint(uint64_t id, const geometry::Vec3& world, const std::shared_ptr<KeyFrame>& reference_keyframe,
            uint64_t first_frame_id);
@@ -39,12 +44,22 @@ class MapPoint {
   [[nodiscard]] float max_distance() const;
   // Pyramid level at which the point is expected to be seen from `distance` metres away.
   [[nodiscard]] int predict_scale(float distance, const ScaleLevels& levels) const;
+  // All of the above under one lock (projecting ~10^4 local points per frame took five locks each).
+  struct ViewGeometry {
+    geometry::Vec3 world;
+    geometry::Vec3 normal;
+    float min_distance = 0;  // as min_distance() / max_distance()
+    float max_distance = 0;
+    float scale_distance = 0;  // what predict_scale uses
+    [[nodiscard]] int predict_scale(float distance, const ScaleLevels& levels) const;
+  };
+  [[nodiscard]] ViewGeometry view_geometry() const;
 
   // Observations (keyframe id -> keypoint index).
   void add_observation(const std::shared_ptr<KeyFrame>& keyframe, size_t index);
   // When two or fewer observations remain the point is set bad (and so unlinked from its keyframes).
   void erase_observation(uint64_t keyframe_id);
-  [[nodiscard]] std::map<uint64_t, Observation> observations() const;
+  [[nodiscard]] Observations observations() const;
   // Calls visit(keyframe_id, observation) for each observation under the point's lock, without copying
   // them (the hot loops of tracking and local mapping). `visit` must not call back into this point; it
   // may read the observing keyframe's immutable data and its atomic flags, nothing that takes a lock.
@@ -83,6 +98,18 @@ class MapPoint {
   // How many of the newest verdicts in a row said "moving" (0-8).
   [[nodiscard]] int moving_run() const;
 
+  // A pass's scratch mark (ORB-SLAM's mnTrackReferenceForFrame): a pass over many points takes a fresh
+  // value from next_mark() and asks mark(value) of each point instead of keeping a hash set of the
+  // points it has seen (tracking's local map: ~10^4 points per frame). Values are process-wide unique,
+  // so passes of different systems or threads never mistake each other's marks; two passes over the
+  // same point at the same time would, so only the tracking thread of the map's system marks.
+  [[nodiscard]] static uint64_t next_mark();
+  // True when the point did not carry `value` yet (and now does).
+  bool mark(uint64_t value) { return pass_mark_.exchange(value, std::memory_order_relaxed) != value; }
+  [[nodiscard]] bool marked(uint64_t value) const {
+    return pass_mark_.load(std::memory_order_relaxed) == value;
+  }
+
   // Saved maps (mapdb/): the viewing geometry and statistics as stored, and their restoration on load.
   struct SavedState {
     geometry::Vec3 normal = geometry::Vec3::Zero();
@@ -109,7 +136,10 @@ class MapPoint {
   float max_distance_ = 0;
 
   mutable std::mutex features_mutex_;  // everything below
-  std::map<uint64_t, Observation> observations_;
+  Observations observations_;          // sorted by keyframe id
+  // The entry of `keyframe_id`, or end(); caller holds features_mutex_.
+  Observations::iterator find_observation(uint64_t keyframe_id);
+  Observations::const_iterator find_observation(uint64_t keyframe_id) const;
   int num_observations_ = 0;
   std::weak_ptr<KeyFrame> reference_keyframe_;
   Descriptor descriptor_{};
@@ -120,6 +150,7 @@ class MapPoint {
   uint8_t motion_bits_ = 0;  // the last kMotionWindow verdicts, newest in bit 0 (1 = moving)
   std::atomic<bool> bad_{false};
   std::weak_ptr<MapPoint> replaced_by_;
+  std::atomic<uint64_t> pass_mark_{0};
 };
 
 }  // namespace crowdslam::map

@@ -304,16 +304,17 @@ int fuse(const std::shared_ptr<map::KeyFrame>& keyframe, const std::vector<std::
   int fused = 0;
   for (const auto& point : points) {
     if (!point || point->is_bad() || point->is_observed_by(keyframe->id)) continue;
-    const geometry::Vec3 world = point->world();
+    const map::MapPoint::ViewGeometry view = point->view_geometry();
+    const geometry::Vec3& world = view.world;
     const geometry::Vec3 in_cam = cam_from_world * world;
     if (in_cam.z() <= 0) continue;
     const geometry::Vec2 pixel = cam.project(in_cam);
     if (!f.grid.bounds().contains(pixel)) continue;
     const geometry::Vec3 ray = world - centre;
     const double distance = ray.norm();
-    if (distance < point->min_distance() || distance > point->max_distance()) continue;
-    if (ray.dot(point->normal()) < 0.5 * distance) continue;
-    const int level = point->predict_scale(static_cast<float>(distance), levels);
+    if (distance < view.min_distance || distance > view.max_distance) continue;
+    if (ray.dot(view.normal) < 0.5 * distance) continue;
+    const int level = view.predict_scale(static_cast<float>(distance), levels);
     const double r = radius * levels.scale[level];
     const auto candidates = f.grid.features_in_area(f.keys_un, static_cast<float>(pixel.x()),
                                                     static_cast<float>(pixel.y()), static_cast<float>(r));

@@ -194,7 +194,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       }
       temporal_points_.clear();
       // A bridged frame is a keyframe whenever one can be made: the map has no points where it looks.
-      KeyframeDecision decision = localization_only_                    ? KeyframeDecision::kNo
+      KeyframeDecision decision = localization_only_                 ? KeyframeDecision::kNo
                                   : bridged && !mapper_->is_paused() ? KeyframeDecision::kInsert
                                                                      : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
@@ -468,11 +468,11 @@ void Tracker::update_local_map(const map::Frame& frame) {
   if (best) reference_keyframe_ = best;
 
   local_points_.clear();
-  std::unordered_set<uint64_t> seen;
+  const uint64_t pass = map::MapPoint::next_mark();
   for (const auto& kf : local_keyframes_) {
-    for (auto& p : kf->valid_map_points()) {
-      if (seen.insert(p->id).second) local_points_.push_back(std::move(p));
-    }
+    kf->for_each_map_point([&](const std::shared_ptr<map::MapPoint>& p) {
+      if (!p->is_bad() && p->mark(pass)) local_points_.push_back(p);
+    });
   }
 }
 
@@ -480,16 +480,16 @@ bool Tracker::track_local_map(map::Frame& frame) {
   update_local_map(frame);
   frame.reference_keyframe = reference_keyframe_;
 
-  std::unordered_set<const map::MapPoint*> already;
+  const uint64_t in_frame = map::MapPoint::next_mark();  // the frame's own points are not searched again
   for (const auto& p : frame.map_points) {
     if (!p || p->is_bad()) continue;
-    already.insert(p.get());
+    p->mark(in_frame);
     p->increase_visible();
   }
   std::vector<match::ProjectedPoint> projected;
   projected.reserve(local_points_.size());
   for (const auto& p : local_points_) {
-    if (already.count(p.get())) continue;
+    if (p->marked(in_frame)) continue;
     if (auto projection = frame.project(*p, 0.5)) {
       p->increase_visible();
       projected.push_back({p, *projection});
