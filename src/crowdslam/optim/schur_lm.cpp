@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "crowdslam/optim/schur_kernel.h"
 #include "crowdslam/optim/se3_update.h"
 
 namespace crowdslam::optim {
@@ -145,6 +146,14 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
   std::vector<SE3> trial_poses;
   std::vector<Vec3> trial_points;
   Eigen::MatrixXd s(6 * num_free, 6 * num_free);
+  // Scratch of the pair kernel: one point's free observations (W V^-1, W, pose index).
+  int max_per_point = 0;
+  for (int p = 0; p < num_points; ++p)
+    max_per_point = std::max(max_per_point, point_start[p + 1] - point_start[p]);
+  std::vector<double> pair_y(18 * static_cast<size_t>(max_per_point));
+  std::vector<double> pair_w(18 * static_cast<size_t>(max_per_point));
+  std::vector<int> pair_pose(static_cast<size_t>(max_per_point));
+  const schur_kernel::SubtractPairs subtract_pairs = schur_kernel::subtract_pairs();
   Eigen::VectorXd rhs(6 * num_free);
   double mu = kInitialMu;
   double nu = 2.0;
@@ -200,26 +209,20 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
       damped.computeInverseWithCheck(v_inverse[p], invertible);
       if (!invertible) v_inverse[p].setZero();
       const Vec3 b_point = -g_point[p];
+      // The point's free observations in plain arrays for the pair kernel (schur_kernel.h).
+      int m = 0;
       for (int a = begin; a < end; ++a) {
         const int ia = by_point[a];
         const int fa = free_index[observations[ia].pose];
         if (fa < 0) continue;
-        const Mat63 y = w[ia] * v_inverse[p];
+        Eigen::Map<Mat63> y(pair_y.data() + 18 * m);
+        y.noalias() = w[ia] * v_inverse[p];
         rhs.segment<6>(6 * fa).noalias() -= y * b_point;
-        for (int b = a; b < end; ++b) {
-          const int ib = by_point[b];
-          const int fb = free_index[observations[ib].pose];
-          if (fb < 0) continue;
-          const Mat6 block = y * w[ib].transpose();
-          if (a == b || fa < fb) {
-            s.block<6, 6>(6 * fa, 6 * fb) -= block;
-          } else if (fa > fb) {
-            s.block<6, 6>(6 * fb, 6 * fa) -= block.transpose();
-          } else {
-            s.block<6, 6>(6 * fa, 6 * fa) -= block + block.transpose();
-          }
-        }
+        Eigen::Map<Mat63>(pair_w.data() + 18 * m) = w[ia];
+        pair_pose[m] = fa;
+        ++m;
       }
+      subtract_pairs({pair_y.data(), pair_w.data(), pair_pose.data(), m}, s.data(), s.outerStride());
     }
     const Eigen::LLT<Eigen::MatrixXd, Eigen::Upper> llt(s);
     if (num_free > 0 && llt.info() != Eigen::Success) {
