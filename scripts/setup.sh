@@ -11,6 +11,7 @@ shift || true
 packages=(
   build-essential cmake ninja-build pkg-config git ca-certificates curl time python3
   libopencv-dev libeigen3-dev libceres-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libjpeg62-turbo-dev
+  libdeflate-dev   # fast inflate (and CRC-32) for the PNG decoder: depth maps, KITTI/TUM images
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev
   opencv-doc   # sample photographs and videos: textures for `crowdslam synth`, vocabulary training
   libjs-chart.js chromium   # report.html inlines Chart.js; the report tests open it in headless Chromium
