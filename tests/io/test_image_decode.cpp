@@ -17,15 +17,8 @@ namespace fs = std::filesystem;
 using test::error_of;
 using Bytes = std::vector<unsigned char>;
 
-Bytes read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return Bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-void write_bytes(const fs::path& path, const Bytes& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-}
+using test::read_bytes;
+using test::write_bytes;
 
 // A noisy colour JPEG (large entropy-coded segment), as written by OpenCV (quality 95).
 fs::path noise_jpeg(const test::TempDir& dir, const std::string& name, int type = CV_8UC3) {

@@ -34,6 +34,9 @@ class TempDir {
 
 void write_text(const std::filesystem::path& path, const std::string& content);
 std::string read_text(const std::filesystem::path& path);
+// A file's bytes (empty when it cannot be read) and writing bytes to one.
+std::vector<unsigned char> read_bytes(const std::filesystem::path& path);
+void write_bytes(const std::filesystem::path& path, const std::vector<unsigned char>& bytes);
 
 // Two real bonn_crowd frames (colour and depth) copied into `dir` in TUM layout (rgb.txt, depth.txt).
 struct TwoBonnFrames {
