@@ -36,7 +36,7 @@ void subtract_pairs_baseline(const PointPairs& point, double* s, std::ptrdiff_t 
 
 // The fastest variant this CPU runs (decided once).
 [[nodiscard]] SubtractPairs subtract_pairs();
-// "avx2+fma" or "baseline": which variant subtract_pairs() is (for run statistics and tests).
+// "avx2+fma" or "baseline": which variant subtract_pairs() is.
 [[nodiscard]] const char* subtract_pairs_variant();
 
 }  // namespace crowdslam::optim::schur_kernel
