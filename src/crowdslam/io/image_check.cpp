@@ -43,11 +43,6 @@ std::vector<unsigned char> read_image_bytes(const std::string& path) {
   return bytes;
 }
 
-std::uint32_t load_be32(const unsigned char* p) {
-  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
-         std::uint32_t{p[3]};
-}
-
 // CRC-32 (ISO-HDLC, as PNG and zlib). libdeflate's uses carry-less multiplication where the CPU has it:
 // about 0.01 ms for a 240 KB KITTI image, 12 times faster than a slice-by-8 table.
 std::uint32_t crc32(const unsigned char* p, std::size_t n) { return libdeflate_crc32(0, p, n); }

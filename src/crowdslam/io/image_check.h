@@ -12,7 +12,7 @@
 //     short (before IEND) or with a flipped bit is an error naming the file, and libpng never sees it.
 //     The common PNGs (8/16-bit grey, RGB, RGBA, not interlaced: depth maps, KITTI/TUM images) are then
 //     decoded by png_decode.h (libdeflate, about 3 times faster, same pixels; image data that does not
-//     inflate to exactly the image's size is an error naming the file); the rest by cv::imdecode.
+//     inflate or inflates short is an error naming the file); the rest by cv::imdecode.
 //   - Other formats are only checked by decoding (cv::imdecode).
 // Files are read into memory once; decoding does not touch the disk again.
 #include <opencv2/core.hpp>

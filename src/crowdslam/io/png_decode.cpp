@@ -25,11 +25,6 @@ constexpr std::size_t kMaxInflateRatio = 1100;
 // Per-thread buffers larger than this are freed after each image rather than kept for the next one.
 constexpr std::size_t kKeepScratchBytes = std::size_t{64} << 20;
 
-std::uint32_t load_be32(const unsigned char* p) {
-  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
-         std::uint32_t{p[3]};
-}
-
 bool chunk_is(const unsigned char* type, const char* name) { return std::memcmp(type, name, 4) == 0; }
 
 // What decoding needs from the chunks.
@@ -276,9 +271,9 @@ Conversion conversion_for(int channels, bool sixteen, bool unchanged) {
   throw input_error(clip_text(path), "corrupt PNG image (" + what + ")");
 }
 
-// Inflates all IDAT data into `raw` (exactly raw_size bytes) or throws.
-// False when the image data holds more than the image (more rows, or bytes after the zlib stream): libpng
-// only warns about those and decodes the image, so the caller leaves such a file to cv::imdecode as before.
+// Inflates all IDAT data into `raw` (exactly raw_size bytes); throws when it does not inflate or is short.
+// False when it holds more than the image (more rows, or bytes after the zlib stream): libpng only warns
+// about those and decodes the image, so the caller leaves such a file to cv::imdecode, as before.
 bool inflate_image_data(const unsigned char* data, const PngLayout& png, Scratch& scratch, unsigned char* raw,
                         std::size_t raw_size, const std::string& path) {
   const unsigned char* in = data + png.first_idat + 8;

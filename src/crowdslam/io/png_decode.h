@@ -18,6 +18,7 @@
 // with libpng). Image data with more than the image (extra rows, or bytes after the zlib stream) is left to
 // cv::imdecode, which decodes it as before (libpng only warns).
 #include <cstddef>
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -28,6 +29,12 @@ namespace crowdslam::io {
 // Throws InputError "PATH: corrupt PNG image (...)" for image data that does not inflate (bad deflate
 // data, Adler-32 mismatch), inflates to too little, or has a row filter type above 4.
 cv::Mat decode_png(const unsigned char* data, std::size_t size, int flags, const std::string& path);
+
+// A big-endian 32-bit value (PNG chunk lengths and IHDR fields).
+inline std::uint32_t load_be32(const unsigned char* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
+         std::uint32_t{p[3]};
+}
 
 // The PNG Paeth predictor of a byte from its left (a), upper (b) and upper-left (c) neighbours, without
 // branches: a when |p-a| is smallest (p = a + b - c), else b when |p-b| <= |p-c|, else c.
