@@ -1,10 +1,14 @@
 // End-to-end: the detector modes and box tracks on a synthetic crowd whose person boxes are known (the
-// generator's boxes through the MOT-file detector), and the new map after a long loss.
+// generator's boxes through the MOT-file detector), and the new map after a long loss (in sensor time).
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "blank_frames.h"
 #include "crowdslam/run/run_sequence.h"
@@ -176,4 +180,56 @@ TEST(RunPeopleModes, LongLossStartsANewMapAndKeepsTheOldOne) {
   ASSERT_GE(segments.size(), 2u);
   EXPECT_GE(segments[0]["tracked"].get<int>(), 40);
   EXPECT_GE(segments.back()["tracked"].get<int>(), 15);
+}
+
+namespace {
+// Stretches the time of a TUM-layout folder (its image lists and ground truth) by `factor` from the first
+// stamp: the synthetic 30 Hz sequence becomes a 30 / factor Hz one with the same images.
+void stretch_time(const std::filesystem::path& dir, double factor) {
+  for (const char* name : {"rgb.txt", "depth.txt", "groundtruth.txt"}) {
+    std::vector<std::string> lines;
+    {
+      std::ifstream in(dir / name);
+      for (std::string line; std::getline(in, line);) lines.push_back(line);
+    }
+    std::ofstream out(dir / name);
+    for (const auto& line : lines) {
+      if (line.empty() || line[0] == '#') {
+        out << line << '\n';
+        continue;
+      }
+      const size_t space = line.find(' ');
+      const double t = std::stod(line.substr(0, space));
+      char stamp[32];
+      std::snprintf(stamp, sizeof stamp, "%.6f", synth::kFirstTimestampS + (t - synth::kFirstTimestampS) * factor);
+      out << stamp << line.substr(space) << '\n';
+    }
+  }
+}
+}  // namespace
+
+// The new map comes after a second without relocalising, not after a fixed number of frames: at 5 Hz,
+// 8 black frames (1.6 s) start a new map (a count of 30 frames, one second at 30 Hz, meant 6 s here).
+TEST(RunPeopleModes, AShortLossAtALowFrameRateStartsANewMapAfterOneSecond) {
+  test::TempDir tmp;
+  synth::SynthOptions options;
+  options.frames = 70;  // the default loop: 17 keyframes by frame 40 (a map that is kept, not reset)
+  options.seed = 2;
+  const auto dir = tmp / "slow";
+  synth::write_sequence(options, dir);
+  stretch_time(dir, 6.0);  // 5 Hz
+  ASSERT_EQ(test::blank_frames(dir / "rgb", 40, 48), 8);
+  run::RunOptions run;
+  run.dataset = dir.string();
+  run.out_dir = (tmp / "out").string();
+  run.sequential = true;
+  run.progress = false;
+  run.people_filter = false;
+  const auto summary = run::run_sequence(run);
+  const auto& segments = summary.json["segments"];
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_EQ(summary.json["summary"]["map_resets"], 1);
+  EXPECT_EQ(segments[0]["tracked"].get<int>(), 40);  // frames 0-39
+  EXPECT_EQ(segments[1]["tracked"].get<int>(), 22);  // frames 48-69, the new map from the first image back
+  EXPECT_EQ(summary.tracked, 62u);
 }

@@ -340,15 +340,17 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   }
   records_.push_back(std::move(record));
   // Monocular initialisation makes its reference frame (an earlier frame, reported not initialised then)
-  // the first keyframe: that frame's pose is the keyframe's, so it is tracked too.
-  const auto keyframes = options_.sensor == io::SensorKind::kMonocular && result.method == std::string("init")
+  // the first keyframe: that frame's pose is the keyframe's, so it is tracked too. Earlier frames the map
+  // localises come with the initialising frame or, tried again once the map has grown, with a later one.
+  const bool init = result.method == std::string("init");
+  const auto keyframes = options_.sensor == io::SensorKind::kMonocular && (init || !result.recovered_before_init.empty())
                              ? map_->keyframes()  // sorted by id: the first is the reference frame's
                              : std::vector<std::shared_ptr<map::KeyFrame>>{};
   if (!keyframes.empty() && keyframes.front()->frame_id < records_.size()) {
     const auto& first = keyframes.front();
-    // The earlier frames the new map localised (TrackResult::recovered_before_init), and the reference.
+    // The earlier frames the map localised (TrackResult::recovered_before_init), and the reference.
     auto recovered = result.recovered_before_init;
-    recovered.emplace_back(first->frame_id, first->cam_from_world());
+    if (init) recovered.emplace_back(first->frame_id, first->cam_from_world());
     for (const auto& [frame_id, cam_from_world] : recovered) {
       if (frame_id >= records_.size()) continue;
       TrajectoryRecord& earlier = records_[frame_id];

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <numeric>
 #include <unordered_map>
@@ -56,6 +57,7 @@ Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, K
 
 void Tracker::reset() {
   lost_frames_ = 0;
+  last_tracked_s_.reset();
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
   last_box_frame_.reset();
@@ -69,6 +71,8 @@ void Tracker::reset() {
   monocular_initializer_.reset();
   frames_before_init_.clear();
   recovered_before_init_.clear();
+  frames_to_retry_.clear();
+  retries_before_init_ = 0;
 }
 
 void Tracker::start_in_loaded_map(bool localization_only) {
@@ -179,6 +183,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     }
     if (ok) {
       lost_frames_ = 0;
+      last_tracked_s_ = frame.timestamp_s;
       if (last_frame_ && last_frame_->cam_from_world) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else if (!options_.monocular) {
@@ -214,16 +219,20 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       }
       // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
       frame.discard_outliers();
+      if (!frames_to_retry_.empty()) result.recovered_before_init = retry_frames_before_init();
     } else {
       velocity_.reset();
       ++lost_frames_;
+      if (!last_tracked_s_) last_tracked_s_ = frame.timestamp_s;  // lost from its first frame (a new map)
+      const double lost_s = std::abs(frame.timestamp_s - *last_tracked_s_);
       if (!map_loaded_ &&
           map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
         result.map_reset = true;
-      } else if (!map_loaded_ && options_.new_map_after_lost_frames > 0 &&
-                 lost_frames_ >= options_.new_map_after_lost_frames) {
-        spdlog::warn("tracking lost for {} frames without relocalising: starting a new map", lost_frames_);
+      } else if (!map_loaded_ && options_.new_map_after_lost_s > 0 && lost_s >= options_.new_map_after_lost_s &&
+                 lost_frames_ >= options_.new_map_after_lost_min_frames) {
+        spdlog::warn("tracking lost for {} frames ({:.1f} s) without relocalising: starting a new map", lost_frames_,
+                     lost_s);
         result.map_reset = true;
       }
     }

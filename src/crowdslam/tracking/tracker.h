@@ -43,6 +43,10 @@ struct TrackerOptions {
   // A keyframe is due when the frame tracks fewer than this fraction of its reference keyframe's points
   // (ORB-SLAM2 uses 0.75 for RGB-D; more keyframes measured better, see docs/RESULTS.md).
   double keyframe_reference_ratio = 0.9;
+  // Monocular: a frame that tracks fewer map points than this is a few bad frames from being lost, so it
+  // asks for a keyframe whatever the reference ratio says, and waits for a busy mapper (backpressure)
+  // rather than going on without new points (docs/MAPPING.md, session 17). 0 = off.
+  int monocular_weak_tracking_inliers = 100;
   // RGB-D / stereo with keyframe_reference_min_found = 0 (the default counts frames, below): the reference
   // keyframe's points counted for that ratio are those seen by at least this many keyframes (ORB-SLAM2:
   // 3; 2 while the map has two keyframes; monocular keeps 3). With 3, a
@@ -62,8 +66,11 @@ struct TrackerOptions {
   // Lost for this many frames in a row without relocalising: start a new map (0 = never; ORB-SLAM2 stays
   // lost until the camera returns, ORB-SLAM3's Atlas starts a new map at once). The camera is somewhere the
   // map does not cover; a new map tracks it from here on, and the old map's poses stay in the outputs as
-  // their own segment. Never with a loaded map. Usually one second of frames.
-  int new_map_after_lost_frames = 30;
+  // their own segment. Never with a loaded map. Measured in sensor time, so that a 3 Hz sequence (or
+  // KITTI at 10 Hz) does not wait 30 frames (10 s, 100 m of driving) as a frame count tuned for 30 Hz
+  // cameras did; at least `new_map_after_lost_min_frames` relocalisation attempts are made first.
+  double new_map_after_lost_s = 1.0;
+  int new_map_after_lost_min_frames = 3;
   // RGB-D / stereo: a frame the motion model places with at least this many inliers among the last
   // frame's points, its depth points (visual odometry) included, is tracked even when it sees too few
   // map points for the local map, and becomes a keyframe at once, so the map gets points where the camera
@@ -111,6 +118,8 @@ struct TrackResult {
   // Monocular initialisation (method "init"): the frames offered to the initializer before this one
   // (since the last reset, at most kMaxFramesBeforeInit) that could be localised in the new map, as
   // (frame id, cam_from_world). The initializer's reference frame is the first keyframe, not listed here.
+  // Frames before the reference that the two-view map could not localise are tried again once the map
+  // has grown (retry_frames_before_init); those found then are listed on that later frame's result.
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered_before_init;
 };
 
@@ -166,6 +175,10 @@ class Tracker {
   // the new map localises (tracker_monocular.cpp).
   std::vector<std::pair<uint64_t, geometry::SE3>> localize_frames_before_init(const map::Frame& init_frame,
                                                                               uint64_t reference_id);
+  // The frames before the initializer's reference that failed, tried again backwards from the earliest
+  // localised frame once the map has kRetryKeyframes[k] keyframes (the mapper has triangulated more of
+  // the first views than the two-view initialisation could). Each frame found is returned once.
+  std::vector<std::pair<uint64_t, geometry::SE3>> retry_frames_before_init();
   enum class KeyframeDecision { kNo, kInsert, kWaitForMapper };
   KeyframeDecision need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);
@@ -210,7 +223,8 @@ class Tracker {
   std::shared_ptr<map::KeyFrame> last_keyframe_;
   uint64_t last_keyframe_frame_id_ = 0;
   uint64_t last_relocalization_frame_id_ = 0;
-  int lost_frames_ = 0;  // consecutive lost frames (new_map_after_lost_frames)
+  int lost_frames_ = 0;  // consecutive lost frames (new_map_after_lost_min_frames)
+  std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
   int inliers_in_local_map_ = 0;
   bool map_loaded_ = false;
   bool localization_only_ = false;
@@ -225,6 +239,12 @@ class Tracker {
   static constexpr size_t kMaxFramesBeforeInit = 60;
   std::deque<map::Frame> frames_before_init_;
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered_before_init_;  // of the initialising frame
+  // retry_frames_before_init: the failed earlier frames (oldest first), the pose of the frame after the
+  // newest of them relative to the first keyframe, and how many retries were made.
+  std::deque<map::Frame> frames_to_retry_;
+  geometry::SE3 retry_anchor_from_first_;
+  geometry::SE3 retry_step_;  // cam_from_world(earlier) * world_from_cam(later) for one frame, last measured
+  size_t retries_before_init_ = 0;
 };
 
 }  // namespace crowdslam::tracking

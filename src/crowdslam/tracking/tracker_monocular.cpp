@@ -65,6 +65,47 @@ geometry::SE3 interpolate(const geometry::SE3& a, const geometry::SE3& b, double
   return geometry::SE3(q, c).inverse();
 }
 
+
+// A frame before the initialisation, matched by projection to `points` from the pose guess, wide then
+// narrow, and its pose optimised; it counts when it keeps the 50 inliers a pose from new matches needs
+// (as relocalisation).
+std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::SE3& guess,
+                                             const std::vector<std::shared_ptr<map::MapPoint>>& points,
+                                             const optim::PoseOptimizerOptions& options) {
+  constexpr int kMinInliers = 50;
+  frame.cam_from_world = guess;
+  for (const double radius_factor : {6.0, 1.5}) {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    std::fill(frame.outliers.begin(), frame.outliers.end(), false);
+    std::vector<match::ProjectedPoint> projected;
+    for (const auto& p : points) {
+      if (!p || p->is_bad()) continue;
+      if (auto projection = frame.project(*p, 0.5)) projected.push_back({p, *projection});
+    }
+    match::search_local_points(frame, projected, radius_factor);
+    if (optimize_frame_pose(frame, options) < kMinInliers) return std::nullopt;
+  }
+  return frame.cam_from_world;
+}
+
+// Frames before `later` (newest first in `frames`, which keeps those that fail), each from the pose of the
+// frame after it moved by the last measured step; stops at the first failure.
+// `step` is cam_from_world(earlier) * world_from_cam(later) for one frame interval, as last measured.
+std::vector<std::pair<uint64_t, geometry::SE3>> localize_backwards(
+    std::deque<map::Frame>& frames, geometry::SE3& later, geometry::SE3& step,
+    const std::vector<std::shared_ptr<map::MapPoint>>& points, const optim::PoseOptimizerOptions& options) {
+  std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
+  while (!frames.empty()) {
+    const auto pose = localize_in_map(frames.back(), step * later, points, options);
+    if (!pose) break;
+    step = *pose * later.inverse();
+    later = *pose;
+    recovered.emplace_back(frames.back().id, *pose);
+    frames.pop_back();
+  }
+  return recovered;
+}
+
 }  // namespace
 
 std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_init(const map::Frame& init_frame,
@@ -72,11 +113,11 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   // The frames the initializer saw before the frame that initialised: those after its reference frame
   // lie between the two keyframes (first pose guess: interpolated by time), those before the reference
   // are taken backwards from it (guess: the pose of the frame after, moved by the velocity between the
-  // two frames after). Each is matched by projection to the initial map, wide then narrow, and its pose
-  // optimised; it counts when it keeps the 50 inliers a pose from new matches needs (as relocalisation).
-  // Frames that fail are left lost; going backwards stops at the first failure.
-  constexpr int kMinInliers = 50;
+  // two frames after). Frames between the keyframes that fail are left lost; going backwards stops at
+  // the first failure, and the frames left are tried again when the map has grown (retry).
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
+  frames_to_retry_.clear();
+  retries_before_init_ = 0;
   if (frames_before_init_.empty() || !init_frame.cam_from_world) return recovered;
   const auto points = map_->map_points();
   const auto reference_kf = map_->keyframes().front();  // sorted by id: the reference frame's keyframe
@@ -84,42 +125,56 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   const geometry::SE3 last_pose = *init_frame.cam_from_world;
   const double t0 = reference_kf->timestamp_s;
   const double t1 = init_frame.timestamp_s;
-  const auto localize = [&](map::Frame frame, const geometry::SE3& guess) -> std::optional<geometry::SE3> {
-    frame.cam_from_world = guess;
-    for (const double radius_factor : {6.0, 1.5}) {
-      std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-      std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-      std::vector<match::ProjectedPoint> projected;
-      for (const auto& p : points) {
-        if (!p || p->is_bad()) continue;
-        if (auto projection = frame.project(*p, 0.5)) projected.push_back({p, *projection});
-      }
-      match::search_local_points(frame, projected, radius_factor);
-      if (optimize_frame_pose(frame, options_.pose) < kMinInliers) return std::nullopt;
-    }
-    return frame.cam_from_world;
-  };
   // Between the reference frame and the initialising frame.
   for (const auto& frame : frames_before_init_) {
     if (frame.id <= reference_id || t1 <= t0) continue;
     const double t = std::clamp((frame.timestamp_s - t0) / (t1 - t0), 0.0, 1.0);
-    if (auto pose = localize(frame, interpolate(first_pose, last_pose, t))) recovered.emplace_back(frame.id, *pose);
+    if (auto pose = localize_in_map(frame, interpolate(first_pose, last_pose, t), points, options_.pose)) {
+      recovered.emplace_back(frame.id, *pose);
+    }
   }
   // Before the reference frame, newest first.
-  geometry::SE3 later = first_pose;
-  std::optional<geometry::SE3> step;  // cam_from_world(earlier) * world_from_cam(later), as last measured
-  for (auto it = frames_before_init_.rbegin(); it != frames_before_init_.rend(); ++it) {
-    if (it->id >= reference_id) continue;
-    const geometry::SE3 guess = step ? *step * later : later;
-    const auto pose = localize(*it, guess);
-    if (!pose) break;
-    step = *pose * later.inverse();
-    later = *pose;
-    recovered.emplace_back(it->id, *pose);
+  for (auto& frame : frames_before_init_) {
+    if (frame.id < reference_id) frames_to_retry_.push_back(std::move(frame));
   }
+  // The first step back: the motion between the two keyframes, extrapolated by time to the frame before.
+  geometry::SE3 later = first_pose;
+  retry_step_ = geometry::SE3();
+  if (!frames_to_retry_.empty() && t1 > t0) {
+    const double t = (frames_to_retry_.back().timestamp_s - t0) / (t1 - t0);
+    retry_step_ = interpolate(first_pose, last_pose, std::max(t, -1.0)) * first_pose.inverse();
+  }
+  const auto before = localize_backwards(frames_to_retry_, later, retry_step_, points, options_.pose);
+  recovered.insert(recovered.end(), before.begin(), before.end());
+  retry_anchor_from_first_ = later * first_pose.inverse();
   std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   if (!recovered.empty()) {
     spdlog::info("monocular initialisation: {} earlier frames localised in the new map", recovered.size());
+  }
+  return recovered;
+}
+
+std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_init() {
+  // Tried when the map has this many keyframes (the two-view map's keyframes are the first two).
+  constexpr size_t kRetryKeyframes[] = {4, 8};
+  std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
+  if (frames_to_retry_.empty() || retries_before_init_ >= std::size(kRetryKeyframes) ||
+      map_->num_keyframes() < kRetryKeyframes[retries_before_init_]) {
+    return recovered;
+  }
+  ++retries_before_init_;
+  const auto keyframes = map_->keyframes();
+  if (keyframes.empty()) return recovered;
+  // The first keyframe (the initializer's reference frame) may have moved in bundle adjustment: the frame
+  // after the failed ones is placed relative to it.
+  geometry::SE3 later = retry_anchor_from_first_ * keyframes.front()->cam_from_world();
+  recovered = localize_backwards(frames_to_retry_, later, retry_step_, map_->map_points(), options_.pose);
+  retry_anchor_from_first_ = later * keyframes.front()->world_from_cam();
+  if (retries_before_init_ >= std::size(kRetryKeyframes)) frames_to_retry_.clear();
+  std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (!recovered.empty()) {
+    spdlog::info("{} frames before the initialisation localised in the map of {} keyframes", recovered.size(),
+                 keyframes.size());
   }
   return recovered;
 }
@@ -130,7 +185,8 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
   // idle. No "close points" condition (there is no depth) and no insertion while the mapper is busy:
   // then its bundle adjustment is interrupted so that it becomes free sooner. Unlike ORB-SLAM2, when
   // the keyframe is overdue (max_frames passed) or the frame tracks less than half the reference's
-  // points, tracking waits for the mapper (backpressure) instead of running out of map points.
+  // points, tracking waits for the mapper (backpressure) instead of running out of map points; and a frame
+  // that tracks few points at all (weak tracking) asks for a keyframe even when its reference is as weak.
   constexpr double kReferenceRatio = 0.9;
   constexpr double kUrgentRatio = 0.5;
   if (mapper_->is_paused()) return KeyframeDecision::kNo;
@@ -149,11 +205,14 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
   const bool c1b =
       frame.id >= last_keyframe_frame_id_ + static_cast<uint64_t>(options_.min_frames_between_keyframes) &&
       mapper_idle;
-  const bool c2 = inliers_in_local_map_ < reference_matches * ratio && inliers_in_local_map_ > 15;
+  // Weak tracking: the reference keyframe may itself hold few points (a turn, a low frame rate), and then
+  // frames that track about as many never fall below the ratio while tracking thins out to nothing.
+  const bool weak = inliers_in_local_map_ < options_.monocular_weak_tracking_inliers;
+  const bool c2 = (inliers_in_local_map_ < reference_matches * ratio || weak) && inliers_in_local_map_ > 15;
   if (!c2) return KeyframeDecision::kNo;
   if (mapper_idle && (c1a || c1b)) return KeyframeDecision::kInsert;
   mapper_->interrupt_bundle_adjustment();
-  const bool urgent = c1a || inliers_in_local_map_ < reference_matches * kUrgentRatio;
+  const bool urgent = c1a || weak || inliers_in_local_map_ < reference_matches * kUrgentRatio;
   return urgent && options_.max_wait_for_mapping_ms > 0 ? KeyframeDecision::kWaitForMapper : KeyframeDecision::kNo;
 }
 

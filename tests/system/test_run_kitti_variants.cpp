@@ -1,0 +1,107 @@
+// kitti07_head played another way (issue 11: "other real sequences and variants will be used"): at a
+// third of its rate (3.3 Hz: 6-10 degrees of turn and up to 1.5 m between frames) and from frame 30, in
+// the middle of the left turn. Both broke in session 16: at a third of the rate the threaded run lost
+// track in the turn for good (32 % tracked) because tracking went on with ever fewer points without
+// asking for a keyframe (its reference keyframe was as weak); from frame 30 the six frames before the
+// two-view initialisation stayed unlocalised (91 % tracked).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "crowdslam/run/run_sequence.h"
+#include "test_support.h"
+
+using namespace crowdslam;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> read_lines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+// A KITTI-layout variant of `src`, as scripts/make_variant.py makes it: frames start, start + stride, ...
+// with their times and ground-truth poses; images linked, not copied. Returns the number of frames.
+size_t write_kitti_variant(const fs::path& src, const fs::path& out, size_t start, size_t stride) {
+  const auto times = read_lines(src / "times.txt");
+  const auto poses = read_lines(src / "poses.txt");
+  fs::create_directories(out / "image_0");
+  fs::copy_file(src / "calib.txt", out / "calib.txt");
+  std::ofstream times_out(out / "times.txt");
+  std::ofstream poses_out(out / "poses.txt");
+  size_t n = 0;
+  for (size_t i = start; i < times.size() && i < poses.size(); i += stride, ++n) {
+    char from[32], to[32];
+    std::snprintf(from, sizeof from, "%06zu.png", i);
+    std::snprintf(to, sizeof to, "%06zu.png", n);
+    fs::create_symlink(fs::absolute(src / "image_0" / from), out / "image_0" / to);
+    times_out << times[i] << '\n';
+    poses_out << poses[i] << '\n';
+  }
+  return n;
+}
+
+run::RunOptions kitti_mono(const fs::path& dataset, const fs::path& out) {
+  run::RunOptions options;
+  options.dataset = dataset.string();
+  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
+  options.out_dir = out.string();
+  options.sensor = io::SensorKind::kMonocular;
+  options.progress = false;
+  options.people_filter = false;
+  return options;
+}
+
+}  // namespace
+
+// Threaded (the default): weak tracking asks for a keyframe and waits for the mapper, so the turn at
+// 3.3 Hz is tracked through with one map.
+TEST(RunKittiVariants, AThirdOfTheRateKeepsTrackThroughTheTurn) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  const size_t frames = write_kitti_variant(test::shared_data("kitti07_head"), tmp / "stride3", 0, 3);
+  ASSERT_EQ(frames, 34u);
+  const auto summary = run::run_sequence(kitti_mono(tmp / "stride3", tmp / "out"));
+  EXPECT_EQ(summary.json["summary"]["map_resets"], 0);
+  EXPECT_EQ(summary.segments.size(), 1u);
+  EXPECT_GE(summary.tracked, 33u);  // 97 % of 34
+  ASSERT_TRUE(summary.ate_rmse_m.has_value());
+  EXPECT_LT(*summary.ate_rmse_m, 0.6);  // measured 0.28-0.36 m over the 54 m (session 17)
+  std::printf("[ measured ] kitti07_head every 3rd frame, threaded: %zu/%zu tracked, ATE %.3f m, %d keyframes\n",
+              summary.tracked, summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>());
+}
+
+// From frame 30 the initializer needs 8 frames of the turn; the frames before its reference are taken
+// backwards from it (the first step extrapolated from the two keyframes' motion), and those the two-view
+// map cannot hold are tried again once the mapper has grown the map.
+TEST(RunKittiVariants, ALaterStartLocalisesEveryFrameBeforeTheInitialisation) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  const size_t frames = write_kitti_variant(test::shared_data("kitti07_head"), tmp / "from30", 30, 1);
+  ASSERT_EQ(frames, 70u);
+  auto options = kitti_mono(tmp / "from30", tmp / "out");
+  options.sequential = true;
+  const auto summary = run::run_sequence(options);
+  ASSERT_TRUE(summary.init_frame.has_value());
+  EXPECT_GE(*summary.init_frame, 4u);  // the turn: the first frames do not initialise
+  EXPECT_EQ(summary.json["summary"]["map_resets"], 0);
+  EXPECT_EQ(summary.frames_localized_before_init, *summary.init_frame);
+  EXPECT_EQ(summary.tracked, summary.frames);
+  const auto& json_frames = summary.json["frames"];
+  for (size_t i = 0; i < *summary.init_frame; ++i) {
+    EXPECT_TRUE(json_frames[i]["localized_after_init"].get<bool>()) << i;
+  }
+  ASSERT_TRUE(summary.ate_rmse_m.has_value());
+  EXPECT_LT(*summary.ate_rmse_m, 0.1);  // 40 m of straight road after the turn: measured 0.037 m
+  std::printf("[ measured ] kitti07_head from frame 30: initialised at %zu, %zu/%zu tracked, ATE %.3f m\n",
+              *summary.init_frame, summary.tracked, summary.frames, *summary.ate_rmse_m);
+}
