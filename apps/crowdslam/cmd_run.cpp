@@ -47,6 +47,10 @@ void print_summary(const run::RunSummary& summary) {
   if (accuracy.is_object() && accuracy.contains("sim3_scale")) {
     std::cout << "ATE alignment     sim3 (scale " << accuracy["sim3_scale"].get<double>() << ")\n";
   }
+  if (accuracy.is_object() && accuracy.contains("ate_keyframes_rmse_m")) {
+    std::cout << "ATE keyframes     " << accuracy["ate_keyframes_rmse_m"].get<double>() << " m ("
+              << accuracy["ate_keyframes_poses"].get<size_t>() << " keyframes, aligned on their own)\n";
+  }
   if (summary.rpe_trans_rmse_m) std::cout << "RPE trans RMSE    " << *summary.rpe_trans_rmse_m << " m/s\n";
   std::cout << "outputs           " << summary.out_dir
             << "/{CameraTrajectory.txt,KeyFrameTrajectory.txt,run.json,report.html}\n";

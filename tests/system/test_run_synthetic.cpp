@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "blank_frames.h"
+#include "crowdslam/eval/ate.h"
+#include "crowdslam/io/trajectory.h"
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
@@ -42,6 +44,14 @@ TEST(RunSynthetic, StaticSceneTrackedWithMillimetreAccuracy) {
   EXPECT_EQ(summary.tracked, 150u);
   ASSERT_TRUE(summary.ate_rmse_m.has_value());
   EXPECT_LT(*summary.ate_rmse_m, 0.005);  // exact depth, textured room: a few millimetres
+  // The keyframes' own ATE (run.json accuracy.ate_keyframes_rmse_m) is that of KeyFrameTrajectory.txt.
+  const auto keyframe_poses = io::read_tum_trajectory((tmp / "out" / "KeyFrameTrajectory.txt").string());
+  const auto ground_truth = io::read_tum_trajectory((dataset / "groundtruth.txt").string());
+  const auto keyframe_ate = eval::evaluate_ate(ground_truth, keyframe_poses, eval::AteOptions{});
+  const auto& accuracy = summary.json["accuracy"];
+  EXPECT_EQ(accuracy["ate_keyframes_poses"].get<size_t>(), keyframe_poses.size());
+  EXPECT_NEAR(accuracy["ate_keyframes_rmse_m"].get<double>(), keyframe_ate.translation_error_m.rmse, 1e-6);
+  EXPECT_LT(keyframe_ate.translation_error_m.rmse, 0.005);
   // Sequential: the mapper is always idle, so only the reference test limits keyframes. Counting the
   // reference keyframe's points by keyframe observations made one on 230-250 of the 300 frames of the
   // synthetic rooms (sessions 12-13); counted by the frames that found them, 27 in 150 here.

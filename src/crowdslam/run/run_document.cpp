@@ -105,10 +105,38 @@ void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummar
   summary.total_ms_p95 = percentile(total_ms, 0.95);
 }
 
+namespace {
+// The ATE of the keyframes in the time span of one segment's camera trajectory (own alignment).
+nlohmann::json keyframe_ate(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
+                            const io::Trajectory& segment, const io::Trajectory& keyframes,
+                            const eval::AteOptions& options, int map_id) {
+  double first = segment.front().timestamp_s;
+  double last = first;
+  for (const auto& pose : segment) {
+    first = std::min(first, pose.timestamp_s);
+    last = std::max(last, pose.timestamp_s);
+  }
+  io::Trajectory in_span;
+  for (const auto& pose : keyframes) {
+    if (pose.timestamp_s >= first && pose.timestamp_s <= last) in_span.push_back(pose);
+  }
+  nlohmann::json out = {{"ate_keyframes_poses", in_span.size()}};
+  if (in_span.size() < 3) return out;
+  try {
+    const auto ate = eval::evaluate_ate(ground_truth, in_span, options, ground_truth_name,
+                                        "KeyFrameTrajectory.txt (map " + std::to_string(map_id) + ")");
+    out["ate_keyframes_rmse_m"] = ate.translation_error_m.rmse;
+  } catch (const InputError& e) {
+    out["ate_keyframes_error"] = e.what();
+  }
+  return out;
+}
+}  // namespace
+
 void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
                        const std::vector<io::Trajectory>& segments,
-                       const std::vector<system::MapSegment>& info, bool monocular, RunSummary& summary,
-                       nlohmann::json& accuracy) {
+                       const std::vector<system::MapSegment>& info, const io::Trajectory& keyframes,
+                       bool monocular, RunSummary& summary, nlohmann::json& accuracy) {
   accuracy = nullptr;
   if (ground_truth.empty()) return;
   nlohmann::json per_segment = nlohmann::json::array();
@@ -141,6 +169,7 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
                       {"ate_pairs", ate.matches.size()},
                       {"alignment", eval::to_string(ate_options.alignment)}});
         if (monocular) entry["sim3_scale"] = ate.alignment.scale;
+        entry.update(keyframe_ate(ground_truth, ground_truth_name, trajectory, keyframes, ate_options, result.map_id));
         // Monocular trajectories have an arbitrary scale: RPE at the aligned scale.
         eval::RpeOptions rpe_options;
         if (monocular) rpe_options.scale = ate.alignment.scale;

@@ -18,9 +18,12 @@ nlohmann::json segment_json(const system::MapSegment& segment);
 
 // ATE (Sim3 for monocular, else SE3) and RPE of every segment with at least 3 poses, and the figures of
 // the longest segment (most poses) in the summary. `ground_truth_name` names the file in messages.
+// `keyframes` (KeyFrameTrajectory.txt): each segment's keyframes (those in its time span) get their own
+// ATE, `ate_keyframes_rmse_m`, the figure ORB-SLAM2's evaluations report.
 void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
                        const std::vector<io::Trajectory>& segments, const std::vector<system::MapSegment>& info,
-                       bool monocular, RunSummary& summary, nlohmann::json& accuracy);
+                       const io::Trajectory& keyframes, bool monocular, RunSummary& summary,
+                       nlohmann::json& accuracy);
 
 // Timing statistics over the frames (median, p95) into `summary`.
 void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary);

@@ -308,7 +308,7 @@ RunSummary run_sequence(const RunOptions& options) {
   const auto ground_truth_name = p.source->summary().ground_truth_path;
   evaluate_accuracy(p.source->ground_truth(),
                     ground_truth_name.empty() ? "ground truth" : clip_text(ground_truth_name),
-                    slam.camera_trajectory_segments(), summary.segments,
+                    slam.camera_trajectory_segments(), summary.segments, slam.keyframe_trajectory(),
                     p.sensor == io::SensorKind::kMonocular, summary, accuracy);
   const SkippedFrames skipped = prefetcher.skipped();
   nlohmann::json input = monitor.to_json();
