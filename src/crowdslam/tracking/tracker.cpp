@@ -58,6 +58,7 @@ Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, K
 void Tracker::reset() {
   lost_frames_ = 0;
   last_tracked_s_.reset();
+  map_keyframe_before_next_frame_ = false;
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
   last_box_frame_.reset();
@@ -85,6 +86,16 @@ void Tracker::start_in_loaded_map(bool localization_only) {
 TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
   TrackResult result;
   result.keypoints = static_cast<int>(frame.size());
+  if (map_keyframe_before_next_frame_) {
+    // The last frame tracked weakly and made a keyframe: this frame is tracked once that keyframe's points
+    // exist (triangulated and adjusted), as in sequential mode; otherwise it only sees the points of the
+    // keyframe before, one step late on motion that is already losing the map.
+    map_keyframe_before_next_frame_ = false;
+    const auto wait_start = std::chrono::steady_clock::now();
+    mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
+    result.waited_for_mapping_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
+  }
   std::unique_lock map_lock(map_->update_mutex());
 
   if (state_ == TrackingState::kNotInitialized) {
@@ -209,13 +220,15 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
         map_lock.unlock();
         const bool accepting = mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
         map_lock.lock();
-        result.waited_for_mapping_ms =
+        result.waited_for_mapping_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
         decision = accepting && !mapper_->is_paused() ? KeyframeDecision::kInsert : KeyframeDecision::kNo;
       }
       if (decision == KeyframeDecision::kInsert) {
         create_new_keyframe(frame);
         result.new_keyframe = true;
+        map_keyframe_before_next_frame_ = options_.monocular && options_.max_wait_for_mapping_ms > 0 &&
+                                          inliers_in_local_map_ < options_.monocular_weak_tracking_inliers;
       }
       // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
       frame.discard_outliers();

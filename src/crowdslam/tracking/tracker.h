@@ -45,7 +45,8 @@ struct TrackerOptions {
   double keyframe_reference_ratio = 0.9;
   // Monocular: a frame that tracks fewer map points than this is a few bad frames from being lost, so it
   // asks for a keyframe whatever the reference ratio says, and waits for a busy mapper (backpressure)
-  // rather than going on without new points (docs/MAPPING.md, session 17). 0 = off.
+  // rather than going on without new points, and the next frame waits until the mapper has mapped that
+  // keyframe (docs/MAPPING.md, session 17). 0 = off.
   int monocular_weak_tracking_inliers = 100;
   // RGB-D / stereo with keyframe_reference_min_found = 0 (the default counts frames, below): the reference
   // keyframe's points counted for that ratio are those seen by at least this many keyframes (ORB-SLAM2:
@@ -223,6 +224,7 @@ class Tracker {
   std::shared_ptr<map::KeyFrame> last_keyframe_;
   uint64_t last_keyframe_frame_id_ = 0;
   uint64_t last_relocalization_frame_id_ = 0;
+  bool map_keyframe_before_next_frame_ = false;  // a weak frame's keyframe: the next frame waits for it
   int lost_frames_ = 0;  // consecutive lost frames (new_map_after_lost_min_frames)
   std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
   int inliers_in_local_map_ = 0;
