@@ -73,6 +73,7 @@ void Tracker::reset() {
   frames_before_init_.clear();
   recovered_before_init_.clear();
   frames_to_retry_.clear();
+  retry_first_keyframe_.reset();
   retries_before_init_ = 0;
 }
 

@@ -241,9 +241,10 @@ class Tracker {
   static constexpr size_t kMaxFramesBeforeInit = 60;
   std::deque<map::Frame> frames_before_init_;
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered_before_init_;  // of the initialising frame
-  // retry_frames_before_init: the failed earlier frames (oldest first), the pose of the frame after the
-  // newest of them relative to the first keyframe, and how many retries were made.
+  // retry_frames_before_init: the failed earlier frames (oldest first), the first keyframe and the pose of
+  // the frame after the newest of them relative to it, and how many retries were made.
   std::deque<map::Frame> frames_to_retry_;
+  std::shared_ptr<map::KeyFrame> retry_first_keyframe_;  // the initializer's reference frame's keyframe
   geometry::SE3 retry_anchor_from_first_;
   geometry::SE3 retry_step_;  // cam_from_world(earlier) * world_from_cam(later) for one frame, last measured
   size_t retries_before_init_ = 0;

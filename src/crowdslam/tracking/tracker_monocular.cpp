@@ -147,6 +147,7 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   const auto before = localize_backwards(frames_to_retry_, later, retry_step_, points, options_.pose);
   recovered.insert(recovered.end(), before.begin(), before.end());
   retry_anchor_from_first_ = later * first_pose.inverse();
+  retry_first_keyframe_ = reference_kf;
   std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   if (!recovered.empty()) {
     spdlog::info("monocular initialisation: {} earlier frames localised in the new map", recovered.size());
@@ -163,18 +164,22 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_ini
     return recovered;
   }
   ++retries_before_init_;
-  const auto keyframes = map_->keyframes();
-  if (keyframes.empty()) return recovered;
   // The first keyframe (the initializer's reference frame) may have moved in bundle adjustment: the frame
   // after the failed ones is placed relative to it.
-  geometry::SE3 later = retry_anchor_from_first_ * keyframes.front()->cam_from_world();
+  const auto first = retry_first_keyframe_;
+  if (!first || first->is_bad()) {
+    frames_to_retry_.clear();
+    return recovered;
+  }
+  geometry::SE3 later = retry_anchor_from_first_ * first->cam_from_world();
   recovered = localize_backwards(frames_to_retry_, later, retry_step_, map_->map_points(), options_.pose);
-  retry_anchor_from_first_ = later * keyframes.front()->world_from_cam();
+  retry_anchor_from_first_ = later * first->world_from_cam();
   if (retries_before_init_ >= std::size(kRetryKeyframes)) frames_to_retry_.clear();
+  if (frames_to_retry_.empty()) retry_first_keyframe_.reset();
   std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   if (!recovered.empty()) {
     spdlog::info("{} frames before the initialisation localised in the map of {} keyframes", recovered.size(),
-                 keyframes.size());
+                 map_->num_keyframes());
   }
   return recovered;
 }
