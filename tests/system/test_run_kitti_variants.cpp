@@ -79,8 +79,9 @@ TEST(RunKittiVariants, AThirdOfTheRateKeepsTrackThroughTheTurn) {
   EXPECT_GE(summary.tracked, 33u);  // 97 % of 34
   ASSERT_TRUE(summary.ate_rmse_m.has_value());
   EXPECT_LT(*summary.ate_rmse_m, 0.6);  // measured 0.28-0.36 m over the 54 m (session 17)
-  std::printf("[ measured ] kitti07_head every 3rd frame, threaded: %zu/%zu tracked, ATE %.3f m, %d keyframes\n",
-              summary.tracked, summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>());
+  std::printf(
+      "[ measured ] kitti07_head every 3rd frame, threaded: %zu/%zu tracked, ATE %.3f m, %d keyframes\n",
+      summary.tracked, summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>());
 }
 
 // The same with a mapper slowed by 80 ms per keyframe (SystemOptions::mapper_delay_ms): a frame that
@@ -106,8 +107,9 @@ TEST(RunKittiVariants, AThirdOfTheRateWithASlowMapperWaitsInsteadOfLosingTrack) 
     if (report.waited_for_mapping_ms > 0) ++frames_waited;
   }
   slam.shutdown();
-  std::printf("[ measured ] every 3rd frame, mapper +80 ms: %zu/%zu tracked, %d frames waited, %zu keyframes\n",
-              slam.tracked_frames(), frames, frames_waited, slam.keyframe_trajectory().size());
+  std::printf(
+      "[ measured ] every 3rd frame, mapper +80 ms: %zu/%zu tracked, %d frames waited, %zu keyframes\n",
+      slam.tracked_frames(), frames, frames_waited, slam.keyframe_trajectory().size());
   EXPECT_EQ(slam.map_resets(), 0);
   EXPECT_GE(slam.tracked_frames(), 33u);
   EXPECT_GT(frames_waited, 0);

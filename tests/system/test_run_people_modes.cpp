@@ -41,6 +41,17 @@ run::RunSummary run_with(const std::filesystem::path& dataset, const std::filesy
   options.box_tracker = tracker;
   return run::run_sequence(options);
 }
+
+// Sequential, no people filter (the loss tests below have no people).
+run::RunSummary run_without_filter(const std::filesystem::path& dataset, const std::filesystem::path& out) {
+  run::RunOptions options;
+  options.dataset = dataset.string();
+  options.out_dir = out.string();
+  options.sequential = true;
+  options.progress = false;
+  options.people_filter = false;
+  return run::run_sequence(options);
+}
 }  // namespace
 
 TEST(RunPeopleModes, LatestModePropagatesEveryFrameAndStillTracksTheCrowd) {
@@ -165,15 +176,9 @@ TEST(RunPeopleModes, LongLossStartsANewMapAndKeepsTheOldOne) {
   options.seed = 2;
   const auto dir = tmp / "blind";
   synth::write_sequence(options, dir);
-  // Frames 40-79 black: no features, tracking lost for 40 frames (more than the 30 that start a new map).
+  // Frames 40-79 black: no features, lost for 40 frames (more than the second that starts a new map).
   ASSERT_EQ(test::blank_frames(dir / "rgb", 40, 80), 40);
-  run::RunOptions run;
-  run.dataset = dir.string();
-  run.out_dir = (tmp / "out").string();
-  run.sequential = true;
-  run.progress = false;
-  run.people_filter = false;
-  const auto summary = run::run_sequence(run);
+  const auto summary = run_without_filter(dir, tmp / "out");
   // Frames 0-39 in the first map, 80-99 in a new one (the room seen again is far from frame 39's view).
   EXPECT_GE(summary.tracked, 60u);
   const auto& segments = summary.json["segments"];
@@ -201,7 +206,8 @@ void stretch_time(const std::filesystem::path& dir, double factor) {
       const size_t space = line.find(' ');
       const double t = std::stod(line.substr(0, space));
       char stamp[32];
-      std::snprintf(stamp, sizeof stamp, "%.6f", synth::kFirstTimestampS + (t - synth::kFirstTimestampS) * factor);
+      std::snprintf(stamp, sizeof stamp, "%.6f",
+                    synth::kFirstTimestampS + (t - synth::kFirstTimestampS) * factor);
       out << stamp << line.substr(space) << '\n';
     }
   }
@@ -219,13 +225,7 @@ TEST(RunPeopleModes, AShortLossAtALowFrameRateStartsANewMapAfterOneSecond) {
   synth::write_sequence(options, dir);
   stretch_time(dir, 6.0);  // 5 Hz
   ASSERT_EQ(test::blank_frames(dir / "rgb", 40, 48), 8);
-  run::RunOptions run;
-  run.dataset = dir.string();
-  run.out_dir = (tmp / "out").string();
-  run.sequential = true;
-  run.progress = false;
-  run.people_filter = false;
-  const auto summary = run::run_sequence(run);
+  const auto summary = run_without_filter(dir, tmp / "out");
   const auto& segments = summary.json["segments"];
   ASSERT_EQ(segments.size(), 2u);
   EXPECT_EQ(summary.json["summary"]["map_resets"], 1);

@@ -169,7 +169,8 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
                       {"ate_pairs", ate.matches.size()},
                       {"alignment", eval::to_string(ate_options.alignment)}});
         if (monocular) entry["sim3_scale"] = ate.alignment.scale;
-        entry.update(keyframe_ate(ground_truth, ground_truth_name, trajectory, keyframes, ate_options, result.map_id));
+        entry.update(
+            keyframe_ate(ground_truth, ground_truth_name, trajectory, keyframes, ate_options, result.map_id));
         // Monocular trajectories have an arbitrary scale: RPE at the aligned scale.
         eval::RpeOptions rpe_options;
         if (monocular) rpe_options.scale = ate.alignment.scale;

@@ -21,9 +21,9 @@ nlohmann::json segment_json(const system::MapSegment& segment);
 // `keyframes` (KeyFrameTrajectory.txt): each segment's keyframes (those in its time span) get their own
 // ATE, `ate_keyframes_rmse_m`, the figure ORB-SLAM2's evaluations report.
 void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
-                       const std::vector<io::Trajectory>& segments, const std::vector<system::MapSegment>& info,
-                       const io::Trajectory& keyframes, bool monocular, RunSummary& summary,
-                       nlohmann::json& accuracy);
+                       const std::vector<io::Trajectory>& segments,
+                       const std::vector<system::MapSegment>& info, const io::Trajectory& keyframes,
+                       bool monocular, RunSummary& summary, nlohmann::json& accuracy);
 
 // Timing statistics over the frames (median, p95) into `summary`.
 void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary);

@@ -343,9 +343,10 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   // the first keyframe: that frame's pose is the keyframe's, so it is tracked too. Earlier frames the map
   // localises come with the initialising frame or, tried again once the map has grown, with a later one.
   const bool init = result.method == std::string("init");
-  const auto keyframes = options_.sensor == io::SensorKind::kMonocular && (init || !result.recovered_before_init.empty())
-                             ? map_->keyframes()  // sorted by id: the first is the reference frame's
-                             : std::vector<std::shared_ptr<map::KeyFrame>>{};
+  const auto keyframes =
+      options_.sensor == io::SensorKind::kMonocular && (init || !result.recovered_before_init.empty())
+          ? map_->keyframes()  // sorted by id: the first is the reference frame's
+          : std::vector<std::shared_ptr<map::KeyFrame>>{};
   if (!keyframes.empty() && keyframes.front()->frame_id < records_.size()) {
     const auto& first = keyframes.front();
     // The earlier frames the map localised (TrackResult::recovered_before_init), and the reference.

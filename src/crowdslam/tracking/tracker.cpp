@@ -243,10 +243,11 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
           map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
         result.map_reset = true;
-      } else if (!map_loaded_ && options_.new_map_after_lost_s > 0 && lost_s >= options_.new_map_after_lost_s &&
+      } else if (!map_loaded_ && options_.new_map_after_lost_s > 0 &&
+                 lost_s >= options_.new_map_after_lost_s &&
                  lost_frames_ >= options_.new_map_after_lost_min_frames) {
-        spdlog::warn("tracking lost for {} frames ({:.1f} s) without relocalising: starting a new map", lost_frames_,
-                     lost_s);
+        spdlog::warn("tracking lost for {} frames ({:.1f} s) without relocalising: starting a new map",
+                     lost_frames_, lost_s);
         result.map_reset = true;
       }
     }

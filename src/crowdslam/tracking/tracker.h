@@ -225,8 +225,8 @@ class Tracker {
   uint64_t last_keyframe_frame_id_ = 0;
   uint64_t last_relocalization_frame_id_ = 0;
   bool map_keyframe_before_next_frame_ = false;  // a weak frame's keyframe: the next frame waits for it
-  int lost_frames_ = 0;  // consecutive lost frames (new_map_after_lost_min_frames)
-  std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
+  int lost_frames_ = 0;                          // consecutive lost frames (new_map_after_lost_min_frames)
+  std::optional<double> last_tracked_s_;         // timestamp of the last tracked frame (new_map_after_lost_s)
   int inliers_in_local_map_ = 0;
   bool map_loaded_ = false;
   bool localization_only_ = false;

@@ -65,7 +65,6 @@ geometry::SE3 interpolate(const geometry::SE3& a, const geometry::SE3& b, double
   return geometry::SE3(q, c).inverse();
 }
 
-
 // A frame before the initialisation, matched by projection to `points` from the pose guess, wide then
 // narrow, and its pose optimised; it counts when it keeps the 50 inliers a pose from new matches needs
 // (as relocalisation).
@@ -176,7 +175,8 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_ini
   retry_anchor_from_first_ = later * first->world_from_cam();
   if (retries_before_init_ >= std::size(kRetryKeyframes)) frames_to_retry_.clear();
   if (frames_to_retry_.empty()) retry_first_keyframe_.reset();
-  std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(recovered.begin(), recovered.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   if (!recovered.empty()) {
     spdlog::info("{} frames before the initialisation localised in the map of {} keyframes", recovered.size(),
                  map_->num_keyframes());
