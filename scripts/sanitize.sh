@@ -9,9 +9,9 @@
 # frame prefetcher + journal writer), on every sensor: RGB-D (synthetic, bonn_crowd), monocular
 # (bonn_crowd --sensor mono, kitti07_head and its every-3rd-frame and from-frame-30 variants), stereo
 # (euroc_v101_micro, right-image thread), and a run interrupted by SIGINT mid-way (the fast-stop path),
-# and saved maps (save, localise, continue, export); under TSan also the Python API's thread test (a TSan-built module in Debian's python3, libtsan
-# preloaded). Any sanitizer report fails the script (halt_on_error, non-zero exit, and the logs are also
-# grepped for reports as a second check).
+# and saved maps (save, localise, continue, export); under TSan also the Python API's thread test (a
+# TSan-built module in Debian's python3, libtsan preloaded). Any sanitizer report fails the script
+# (halt_on_error, non-zero exit, and the logs are also grepped for reports as a second check).
 # Environment: CROWDSLAM_JOBS (default 2), CROWDSLAM_SANITIZE_OUT (default out/sanitize),
 #   CROWDSLAM_SANITIZE_BUILD_TYPE (default RelWithDebInfo), CROWDSLAM_SHARED (default ../shared),
 #   CROWDSLAM_SANITIZE_FRAMES (synthetic frames, default 120), CROWDSLAM_SANITIZE_BONN_FRAMES (default 150),
