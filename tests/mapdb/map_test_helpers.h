@@ -9,6 +9,7 @@
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
+#include "run_test_options.h"
 #include "test_support.h"
 
 namespace crowdslam::test {
@@ -25,13 +26,7 @@ inline std::filesystem::path make_room(const TempDir& tmp, int people, int frame
 }
 
 inline run::RunOptions run_options(const std::filesystem::path& dataset, const std::filesystem::path& out) {
-  run::RunOptions options;
-  options.dataset = dataset.string();
-  options.out_dir = out.string();
-  options.sequential = true;
-  options.progress = false;
-  options.people_filter = false;
-  return options;
+  return test::sequential_run_options(dataset, out);
 }
 
 // Every row of a table, rendered as text (blobs as hex), in primary-key order.

@@ -13,6 +13,7 @@
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
 #include "crowdslam/run/run_sequence.h"
+#include "run_test_options.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -21,12 +22,7 @@ namespace {
 
 run::RunSummary run_slam(const std::filesystem::path& dataset, const std::filesystem::path& out, bool loop_closing,
                        size_t max_frames = 0) {
-  run::RunOptions options;
-  options.dataset = dataset.string();
-  options.out_dir = out.string();
-  options.sequential = true;
-  options.progress = false;
-  options.people_filter = false;
+  auto options = test::sequential_run_options(dataset, out);
   options.loop_closing = loop_closing;
   options.max_frames = max_frames;
   return run::run_sequence(options);

@@ -14,6 +14,7 @@
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
+#include "run_test_options.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -44,13 +45,7 @@ run::RunSummary run_with(const std::filesystem::path& dataset, const std::filesy
 
 // Sequential, no people filter (the loss tests below have no people).
 run::RunSummary run_without_filter(const std::filesystem::path& dataset, const std::filesystem::path& out) {
-  run::RunOptions options;
-  options.dataset = dataset.string();
-  options.out_dir = out.string();
-  options.sequential = true;
-  options.progress = false;
-  options.people_filter = false;
-  return run::run_sequence(options);
+  return run::run_sequence(test::sequential_run_options(dataset, out));
 }
 }  // namespace
 
