@@ -7,7 +7,7 @@
 #     --ctest   also build the e2e test executables and run `ctest -L e2e` in the sanitizer build dir
 # Every run uses the default threaded mode (tracking + detection worker + local mapping + loop closing +
 # frame prefetcher + journal writer), on every sensor: RGB-D (synthetic, bonn_crowd), monocular
-# (bonn_crowd --sensor mono, kitti07_head and its every-3rd-frame and from-frame-30 variants), stereo
+# (bonn_crowd --sensor mono, kitti07_head and its every-3rd/4th-frame and from-frame-30 variants), stereo
 # (euroc_v101_micro, right-image thread), and a run interrupted by SIGINT mid-way (the fast-stop path),
 # and saved maps (save, localise, continue, export); under TSan also the Python API's thread test (a
 # TSan-built module in Debian's python3, libtsan preloaded). Any sanitizer report fails the script
@@ -283,10 +283,11 @@ run_sanitizer() {
     run_step "$tag run kitti07_head (mono)" "$out/run_kitti.log" \
       "$bin" run --dataset "$kitti" --settings config/KITTI04-12.yaml --sensor mono --no-people-filter \
       --allow-untracked --out "$out/run_kitti" || true
-    # Every 3rd frame (weak tracking: keyframes the next frame waits for) and from frame 30 (frames before
+    # Every 3rd frame (weak tracking: keyframes the next frame waits for), every 4th (waits for every due
+    # keyframe, the last frame's keyframe points read by the motion model) and from frame 30 (frames before
     # the initialisation retried once the map has grown).
     local variant
-    for variant in "stride3:--stride 3" "from30:--start 30"; do
+    for variant in "stride3:--stride 3" "stride4:--stride 4" "from30:--start 30"; do
       rm -rf "$out/kitti_${variant%%:*}"
       # shellcheck disable=SC2086  # the options are two words on purpose
       python3 scripts/make_variant.py "$kitti" "$out/kitti_${variant%%:*}" ${variant#*:} >/dev/null

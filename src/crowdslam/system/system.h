@@ -29,7 +29,7 @@ struct SystemOptions {
   bool people_filter = true;
   // Person boxes from a MOT-format file instead of the network (frame n of the file = frame n-1 here).
   std::string detections_file;
-  std::string detector_model;  // overrides Detector.model_cfg: "body", "coco", a .cfg or .onnx path
+  std::string detector_model;     // overrides Detector.model_cfg: "body", "coco", a .cfg or .onnx path
   bool record_keypoints = false;  // fill FrameReport::kept_keypoints / removed_keypoints (for drawing)
   // ORB vocabulary for place recognition (relocalisation with the keyframe database, bag-of-words
   // matching): "" = bow::default_vocabulary_path(), "none" = no vocabulary (brute-force relocalisation).
@@ -40,6 +40,10 @@ struct SystemOptions {
   // Backpressure (tracking/tracker.h TrackerOptions::max_wait_for_mapping_ms): how long tracking may
   // wait for local mapping to take an urgently needed keyframe. 0 = never (ORB-SLAM2).
   double max_wait_for_mapping_ms = 1000.0;
+  // Monocular: also wait for keyframes that are due but not urgent (TrackerOptions::
+  // monocular_wait_for_due_keyframes). On for unpaced replays; `crowdslam run --pace sensor` turns it off,
+  // as a live camera would not wait.
+  bool wait_for_due_keyframes = true;
   // Experiments and tests only: local mapping sleeps this long per keyframe (a slow mapper on demand).
   double mapper_delay_ms = 0;
 };
@@ -70,15 +74,16 @@ struct FrameReport {
   double waited_for_mapping_ms = 0;  // part of tracking_ms: waiting for local mapping to take a keyframe
   // People filter.
   int person_boxes = 0;
-  double people_area = 0;      // fraction of the image covered (sum or union, FeatureBudget.area)
+  double people_area = 0;  // fraction of the image covered (sum or union, FeatureBudget.area)
   int keypoints_before_filter = 0;
-  double detector_ms = 0;      // detector forward time (runs on its own thread)
-  double detector_wait_ms = 0; // how long tracking waited for the boxes after ORB extraction
-  int64_t detection_frame = -1;  // frame the boxes were detected on (-1: none yet)
-  bool boxes_propagated = false; // boxes moved here from an earlier frame (Detector.mode latest)
-  bool rescued_with_boxes = false;  // the filtered frame failed; the keypoints in boxes tracked it (Tracker::track)
-  int box_matches = 0;              // tracked points that are keypoints in person boxes (Tracker::track)
-  int static_boxes = 0;             // boxes the static map vouched for, their keypoints released (Tracker::track)
+  double detector_ms = 0;         // detector forward time (runs on its own thread)
+  double detector_wait_ms = 0;    // how long tracking waited for the boxes after ORB extraction
+  int64_t detection_frame = -1;   // frame the boxes were detected on (-1: none yet)
+  bool boxes_propagated = false;  // boxes moved here from an earlier frame (Detector.mode latest)
+  // The filtered frame failed; the keypoints in boxes tracked it (Tracker::track).
+  bool rescued_with_boxes = false;
+  int box_matches = 0;   // tracked points that are keypoints in person boxes (Tracker::track)
+  int static_boxes = 0;  // boxes the static map vouched for, their keypoints released (Tracker::track)
   // Geometric dynamic check (tracking/dynamic_check.h): keypoints judged dynamic (of them, added by region
   // growing), matches whose residual moved in this frame, map points culled as moving.
   int keypoints_dynamic = 0;
@@ -87,14 +92,14 @@ struct FrameReport {
   int points_culled_moving = 0;
   int points_seen_through = 0;  // RGB-D: unmatched local map points the depth image sees through (free space)
   bool dynamic_check_skipped = false;  // failed with the check, tracked without it
-  int right_keypoints_removed = 0;  // stereo, PeopleFilter.right_image: boxes
-  int flat_boxes = 0;               // RGB-D: boxes found flat by the depth test, not filtered
+  int right_keypoints_removed = 0;     // stereo, PeopleFilter.right_image: boxes
+  int flat_boxes = 0;                  // RGB-D: boxes found flat by the depth test, not filtered
   // Stereo: kept left keypoints with a stereo match, time spent waiting for the right image's ORB
   // (extracted on a second thread) and time of the stereo matching (both included in extraction_ms).
   int stereo_matches = 0;
   double right_wait_ms = 0;
   double stereo_match_ms = 0;
-  std::vector<people::PersonBox> boxes;  // used for filtering (for --save-frames)
+  std::vector<people::PersonBox> boxes;         // used for filtering (for --save-frames)
   std::vector<cv::KeyPoint> removed_keypoints;  // only with SystemOptions::record_keypoints
   std::vector<cv::KeyPoint> kept_keypoints;
 };
@@ -190,15 +195,16 @@ class System {
   std::shared_ptr<const bow::Vocabulary> vocabulary_;  // null without a vocabulary
   std::optional<VocabularyInfo> vocabulary_info_;
   std::unique_ptr<loop::KeyframeDatabase> keyframe_database_;  // with a vocabulary only
-  std::unique_ptr<loop::LoopCloser> loop_closer_;               // with a vocabulary and loop closing on
+  std::unique_ptr<loop::LoopCloser> loop_closer_;              // with a vocabulary and loop closing on
   std::unique_ptr<tracking::FrameBuilder> frame_builder_;
   std::unique_ptr<StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
-  bool box_keypoints_ = false;  // the keypoints the people filter removes are offered to tracking (Tracker::BoxKeypoints)
+  bool box_keypoints_ =
+      false;  // the keypoints the people filter removes are offered to tracking (Tracker::BoxKeypoints)
   std::vector<TrajectoryRecord> records_;
-  std::vector<MapSegment> segments_;           // the last one is the current map
-  io::Trajectory past_keyframes_;              // keyframes of maps that were reset
+  std::vector<MapSegment> segments_;  // the last one is the current map
+  io::Trajectory past_keyframes_;     // keyframes of maps that were reset
   std::vector<RunObserver*> observers_;
   std::unique_ptr<PeopleStage> people_;  // null when the people filter is off
   int next_feature_budget_ = 0;

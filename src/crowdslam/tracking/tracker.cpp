@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <numeric>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "crowdslam/loop/keyframe_database.h"
@@ -66,6 +65,7 @@ void Tracker::reset() {
   last_cam_from_reference_.reset();
   reference_keyframe_.reset();
   last_keyframe_.reset();
+  last_keyframe_indices_.clear();
   temporal_points_.clear();
   local_keyframes_.clear();
   local_points_.clear();
@@ -111,14 +111,17 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     bool ok = false;
     const bool was_tracking = state_ == TrackingState::kOk && velocity_ && last_frame_;
     if (last_frame_) replace_replaced_points(*last_frame_);
-    // The dynamic check must never be the reason tracking fails: keep the frame as it came for a retry.
-    std::optional<map::Frame> untouched;
     bool bridged = false;
     odometry_bridge_.reset();
-    if (dynamic_check_.enabled() && was_tracking) untouched = frame;
+    // The frame as it came, for the second tries below: without the motion model, and without the dynamic
+    // check (which must never be the reason tracking fails).
+    std::optional<map::Frame> fresh;
+    if (was_tracking) fresh = frame;
+    bool by_motion_model = false;
     if (state_ == TrackingState::kOk && velocity_ && last_frame_) {
       ok = track_with_motion_model(frame);
       result.method = "motion";
+      by_motion_model = ok;
     }
     if (!ok && state_ == TrackingState::kOk) {
       ok = track_reference_keyframe(frame);
@@ -130,9 +133,23 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     }
     frame.reference_keyframe = reference_keyframe_;
     if (ok) ok = track_local_map(frame);
-    if (!ok && untouched && velocity_) {
+    if (!ok && by_motion_model && fresh) {
+      // The motion model found matches but too few of the local map agree with its pose: on a turn that
+      // speeds up or slows down, the matches in its search windows can hold a wrong pose. The reference
+      // keyframe's bag of words needs no pose guess.
+      map::Frame again = *fresh;
+      if (track_reference_keyframe(again)) {
+        again.reference_keyframe = reference_keyframe_;
+        if (track_local_map(again)) {
+          frame = std::move(again);
+          ok = true;
+          result.method = "reference";
+        }
+      }
+    }
+    if (!ok && fresh && dynamic_check_.enabled() && velocity_) {
       dynamic_check_.set_suspended(true);
-      map::Frame again = std::move(*untouched);
+      map::Frame again = std::move(*fresh);
       if (track_with_motion_model(again)) {
         again.reference_keyframe = reference_keyframe_;
         if (track_local_map(again)) {
@@ -357,6 +374,22 @@ void Tracker::update_last_frame() {
   if (last.reference_keyframe && last_cam_from_reference_) {
     last.cam_from_world = *last_cam_from_reference_ * last.reference_keyframe->cam_from_world();
   }
+  // Monocular: the last frame made a keyframe, so the points local mapping has triangulated in it since
+  // are matched too, not only those the frame tracked. On fast turns they are most of what the next frame
+  // can see of the map. (RGB-D and stereo keyframes take their depth points at creation, above all.)
+  if (options_.monocular && last_keyframe_ && last_keyframe_frame_id_ == last.id &&
+      !last_keyframe_->is_bad()) {
+    for (size_t i = 0; i < last.size(); ++i) {
+      if (last.map_points[i]) continue;
+      const long k = last_keyframe_indices_.empty() ? static_cast<long>(i) : last_keyframe_indices_[i];
+      if (k < 0) continue;
+      auto point = last_keyframe_->map_point(static_cast<size_t>(k));
+      if (point && !point->is_bad()) {
+        last.map_points[i] = std::move(point);
+        last.outliers[i] = false;
+      }
+    }
+  }
   // RGB-D: create visual-odometry points from the last frame's close depth points that have no map point,
   // so the motion model has enough matches even in new areas.
   const auto& f = *last.features;
@@ -441,103 +474,7 @@ bool Tracker::track_reference_keyframe(map::Frame& frame) {
   return discard_outliers_count_map_points(frame) >= 10;
 }
 
-// ---- local map ----
-void Tracker::update_local_map(const map::Frame& frame) {
-  // Keyframes that see the frame's points, weighted by how many.
-  std::unordered_map<uint64_t, std::pair<std::shared_ptr<map::KeyFrame>, int>> counter;
-  for (const auto& p : frame.map_points) {
-    if (!p || p->is_bad()) continue;
-    p->for_each_observation([&](uint64_t kf_id, const map::MapPoint::Observation& obs) {
-      auto& entry = counter[kf_id];
-      if (!entry.first) entry.first = obs.keyframe.lock();
-      ++entry.second;
-    });
-  }
-  for (auto it = counter.begin(); it != counter.end();) {  // keyframes already gone
-    it = it->second.first ? std::next(it) : counter.erase(it);
-  }
-  if (counter.empty()) return;
-  local_keyframes_.clear();
-  std::unordered_set<uint64_t> included;
-  std::shared_ptr<map::KeyFrame> best;
-  int best_count = 0;
-  for (const auto& [id, entry] : counter) {
-    if (entry.first->is_bad()) continue;
-    if (entry.second > best_count) {
-      best_count = entry.second;
-      best = entry.first;
-    }
-    local_keyframes_.push_back(entry.first);
-    included.insert(id);
-  }
-  // Neighbours of those: best covisibles, children and parent (one of each per keyframe).
-  const size_t first_ring = local_keyframes_.size();
-  auto try_add = [&](const std::shared_ptr<map::KeyFrame>& kf) {
-    if (!kf || kf->is_bad() || included.count(kf->id)) return false;
-    included.insert(kf->id);
-    local_keyframes_.push_back(kf);
-    return true;
-  };
-  for (size_t k = 0; k < first_ring; ++k) {
-    if (local_keyframes_.size() > static_cast<size_t>(options_.max_local_keyframes)) break;
-    const auto kf = local_keyframes_[k];
-    for (const auto& neighbour : kf->best_covisible(10)) {
-      if (try_add(neighbour)) break;
-    }
-    for (const auto& child : kf->children()) {
-      if (try_add(child)) break;
-    }
-    try_add(kf->parent());
-  }
-  if (best) reference_keyframe_ = best;
-
-  local_points_.clear();
-  const uint64_t pass = map::MapPoint::next_mark();
-  for (const auto& kf : local_keyframes_) {
-    kf->for_each_map_point([&](const std::shared_ptr<map::MapPoint>& p) {
-      if (!p->is_bad() && p->mark(pass)) local_points_.push_back(p);
-    });
-  }
-}
-
-bool Tracker::track_local_map(map::Frame& frame) {
-  update_local_map(frame);
-  frame.reference_keyframe = reference_keyframe_;
-
-  const uint64_t in_frame = map::MapPoint::next_mark();  // the frame's own points are not searched again
-  for (const auto& p : frame.map_points) {
-    if (!p || p->is_bad()) continue;
-    p->mark(in_frame);
-    p->increase_visible();
-  }
-  std::vector<match::ProjectedPoint> projected;
-  projected.reserve(local_points_.size());
-  for (const auto& p : local_points_) {
-    if (p->marked(in_frame)) continue;
-    if (auto projection = frame.project(*p, 0.5)) {
-      p->increase_visible();
-      projected.push_back({p, *projection});
-    }
-  }
-  if (!projected.empty()) match::search_local_points(frame, projected, options_.local_map_radius_factor);
-
-  optimize_pose(frame);
-  int inliers = 0;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    const auto& p = frame.map_points[i];
-    if (!p || frame.outliers[i]) continue;
-    p->increase_found();
-    if (p->num_observations() > 0) ++inliers;
-  }
-  inliers_in_local_map_ = inliers;
-  const bool recently_relocalized =
-      frame.id <
-          last_relocalization_frame_id_ + static_cast<uint64_t>(options_.max_frames_between_keyframes) &&
-      last_relocalization_frame_id_ > 0;
-  if (recently_relocalized && inliers < 50) return false;
-  return inliers >= 30;
-}
-
-// Keyframe decisions and creation: tracker_keyframes.cpp; monocular parts: tracker_monocular.cpp.
+// Local-map tracking: tracker_local_map.cpp; keyframe decisions and creation: tracker_keyframes.cpp;
+// monocular parts: tracker_monocular.cpp.
 
 }  // namespace crowdslam::tracking

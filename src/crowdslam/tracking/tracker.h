@@ -48,6 +48,11 @@ struct TrackerOptions {
   // rather than going on without new points, and the next frame waits until the mapper has mapped that
   // keyframe (docs/MAPPING.md, session 17). 0 = off.
   int monocular_weak_tracking_inliers = 100;
+  // Monocular, with max_wait_for_mapping_ms > 0: a keyframe that is due (the reference ratio) while the
+  // mapper is busy is waited for, not skipped, so that an unpaced replay makes the keyframes sequential
+  // mode makes and throughput follows the mapper's speed (issue 11). Off (a paced replay, a live camera):
+  // only urgent keyframes are waited for (overdue, weak tracking, under half the reference's points).
+  bool monocular_wait_for_due_keyframes = true;
   // RGB-D / stereo with keyframe_reference_min_found = 0 (the default counts frames, below): the reference
   // keyframe's points counted for that ratio are those seen by at least this many keyframes (ORB-SLAM2:
   // 3; 2 while the map has two keyframes; monocular keeps 3). With 3, a
@@ -110,7 +115,7 @@ struct TrackResult {
   int keypoints = 0;
   // "init", "motion", "reference", "relocalization", "motion+boxes", "odometry", "lost"
   const char* method = "";
-  int box_matches = 0;      // keypoints in person boxes among the tracked points (BoxKeypoints)
+  int box_matches = 0;   // keypoints in person boxes among the tracked points (BoxKeypoints)
   int static_boxes = 0;  // boxes whose keypoints the static map vouched for (released, see box_keypoints.cpp)
   // The filtered frame failed and the keypoints in boxes tracked it (method "motion+boxes").
   bool rescued_with_boxes = false;
@@ -223,6 +228,9 @@ class Tracker {
   std::shared_ptr<map::KeyFrame> reference_keyframe_;
   std::shared_ptr<map::KeyFrame> last_keyframe_;
   uint64_t last_keyframe_frame_id_ = 0;
+  // Per keypoint of the frame that made last_keyframe_: its index in the keyframe (-1 = left out); empty
+  // when the keyframe has the frame's keypoints as they are.
+  std::vector<long> last_keyframe_indices_;
   uint64_t last_relocalization_frame_id_ = 0;
   bool map_keyframe_before_next_frame_ = false;  // a weak frame's keyframe: the next frame waits for it
   int lost_frames_ = 0;                          // consecutive lost frames (new_map_after_lost_min_frames)
@@ -234,7 +242,7 @@ class Tracker {
   // This frame as the motion model placed it, when only the last frame's depth points held it
   // (odometry_bridge_min_inliers); taken if nothing else tracks the frame.
   std::optional<map::Frame> odometry_bridge_;
-  std::optional<map::Frame> last_box_frame_;                     // remember_box_frame
+  std::optional<map::Frame> last_box_frame_;  // remember_box_frame
   std::vector<std::shared_ptr<map::KeyFrame>> local_keyframes_;
   std::vector<std::shared_ptr<map::MapPoint>> local_points_;
   // Monocular: the frames the initializer saw so far (localize_frames_before_init), oldest first.

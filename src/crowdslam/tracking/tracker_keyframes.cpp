@@ -121,6 +121,11 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
   frame.reference_keyframe = keyframe;
   last_keyframe_ = keyframe;
   last_keyframe_frame_id_ = frame.id;
+  if (any_left_out) {
+    last_keyframe_indices_ = std::move(to_keyframe);
+  } else {
+    last_keyframe_indices_.clear();
+  }
   mapper_->insert_keyframe(keyframe);
 }
 

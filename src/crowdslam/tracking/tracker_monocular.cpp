@@ -42,6 +42,7 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
   mapper_->insert_keyframe(second);
   last_keyframe_ = second;
   last_keyframe_frame_id_ = frame.id;
+  last_keyframe_indices_.clear();
   reference_keyframe_ = second;
   frame.reference_keyframe = second;
   local_keyframes_ = {first, second};
@@ -107,8 +108,8 @@ std::vector<std::pair<uint64_t, geometry::SE3>> localize_backwards(
 
 }  // namespace
 
-std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_init(const map::Frame& init_frame,
-                                                                                    uint64_t reference_id) {
+std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_init(
+    const map::Frame& init_frame, uint64_t reference_id) {
   // The frames the initializer saw before the frame that initialised: those after its reference frame
   // lie between the two keyframes (first pose guess: interpolated by time), those before the reference
   // are taken backwards from it (guess: the pose of the frame after, moved by the velocity between the
@@ -147,7 +148,8 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   recovered.insert(recovered.end(), before.begin(), before.end());
   retry_anchor_from_first_ = later * first_pose.inverse();
   retry_first_keyframe_ = reference_kf;
-  std::sort(recovered.begin(), recovered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(recovered.begin(), recovered.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   if (!recovered.empty()) {
     spdlog::info("monocular initialisation: {} earlier frames localised in the new map", recovered.size());
   }
@@ -188,10 +190,11 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
   // ORB-SLAM2, monocular: a keyframe when the frame tracks less than 90 % of the reference keyframe's
   // points (40 % while the map has one keyframe) and either enough frames have passed or the mapper is
   // idle. No "close points" condition (there is no depth) and no insertion while the mapper is busy:
-  // then its bundle adjustment is interrupted so that it becomes free sooner. Unlike ORB-SLAM2, when
-  // the keyframe is overdue (max_frames passed) or the frame tracks less than half the reference's
-  // points, tracking waits for the mapper (backpressure) instead of running out of map points; and a frame
-  // that tracks few points at all (weak tracking) asks for a keyframe even when its reference is as weak.
+  // then its bundle adjustment is interrupted so that it becomes free sooner. Unlike ORB-SLAM2, tracking
+  // waits for the busy mapper (backpressure) instead of going on without the keyframe: for every due
+  // keyframe in an unpaced replay (monocular_wait_for_due_keyframes), otherwise when the keyframe is
+  // overdue (max_frames passed), the frame tracks less than half the reference's points, or it tracks
+  // few points at all (weak tracking: a keyframe then even when its reference is as weak).
   constexpr double kReferenceRatio = 0.9;
   constexpr double kUrgentRatio = 0.5;
   if (mapper_->is_paused()) return KeyframeDecision::kNo;
@@ -217,8 +220,10 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
   if (!c2) return KeyframeDecision::kNo;
   if (mapper_idle && (c1a || c1b)) return KeyframeDecision::kInsert;
   mapper_->interrupt_bundle_adjustment();
-  const bool urgent = c1a || weak || inliers_in_local_map_ < reference_matches * kUrgentRatio;
-  return urgent && options_.max_wait_for_mapping_ms > 0 ? KeyframeDecision::kWaitForMapper : KeyframeDecision::kNo;
+  const bool urgent = options_.monocular_wait_for_due_keyframes || c1a || weak ||
+                      inliers_in_local_map_ < reference_matches * kUrgentRatio;
+  return urgent && options_.max_wait_for_mapping_ms > 0 ? KeyframeDecision::kWaitForMapper
+                                                        : KeyframeDecision::kNo;
 }
 
 }  // namespace crowdslam::tracking
