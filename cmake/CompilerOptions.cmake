@@ -39,10 +39,12 @@ function(crowdslam_add_library)
 endfunction()
 
 # Helper: one GoogleTest executable per module, registered with CTest.
-#   crowdslam_add_test(NAME io SOURCES test_x.cpp DEPS crowdslam::io LABELS unit)
-#   Without SOURCES, every test_*.cpp in the calling folder.
+#   crowdslam_add_test(NAME io SOURCES test_x.cpp DEPS crowdslam::io LABELS unit [SERIAL regex])
+#   Without SOURCES, every test_*.cpp in the calling folder. Tests whose name matches SERIAL run alone
+#   (RUN_SERIAL): threaded runs whose outcome depends on how the mapper keeps up, so that `ctest -j`
+#   neighbours do not take their cores.
 function(crowdslam_add_test)
-  cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;SERIAL" "SOURCES;DEPS;LABELS" ${ARGN})
   set(target test_${ARG_NAME})
   if(NOT ARG_SOURCES)
     file(GLOB ARG_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp)
@@ -57,9 +59,17 @@ function(crowdslam_add_test)
   # Labels (module name + e.g. e2e) are set after discovery: passing a list through
   # gtest_discover_tests(PROPERTIES LABELS ...) keeps only its first element with CMake 3.25.
   set(labels_file "${CMAKE_CURRENT_BINARY_DIR}/${target}_labels.cmake")
+  set(serial_check "")
+  if(ARG_SERIAL)
+    set(serial_check
+      "  if(test_name MATCHES \"${ARG_SERIAL}\")\n"
+      "    set_tests_properties(\"\${test_name}\" PROPERTIES RUN_SERIAL TRUE)\n"
+      "  endif()\n")
+  endif()
   file(WRITE "${labels_file}"
     "foreach(test_name IN LISTS ${target}_TESTS)\n"
     "  set_tests_properties(\"\${test_name}\" PROPERTIES LABELS \"${ARG_NAME};${ARG_LABELS}\")\n"
+    ${serial_check}
     "endforeach()\n")
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_file}")
 endfunction()

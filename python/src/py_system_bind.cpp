@@ -36,7 +36,7 @@ std::unique_ptr<PySystem> make_system(const py::object& settings, const std::str
                                       const std::optional<std::string>& detections, bool sequential,
                                       bool loop_closing, const std::optional<std::string>& filter_mode,
                                       bool record_keypoints, double max_wait_for_mapping_ms,
-                                      bool wait_for_due_keyframes) {
+                                      bool replay_waits_for_mapping) {
   SystemArgs args;
   args.options.sensor = io::parse_sensor_kind(sensor, "System(): sensor");
   args.settings = settings_argument(settings, args.options.sensor);
@@ -61,7 +61,7 @@ std::unique_ptr<PySystem> make_system(const py::object& settings, const std::str
   args.options.loop_closing = loop_closing;
   args.options.record_keypoints = record_keypoints;
   args.options.max_wait_for_mapping_ms = max_wait_for_mapping_ms;
-  args.options.wait_for_due_keyframes = wait_for_due_keyframes;
+  args.options.replay_waits_for_mapping = replay_waits_for_mapping;
   return std::make_unique<PySystem>(std::move(args));
 }
 
@@ -80,7 +80,7 @@ Arguments are those of `crowdslam run` (README "Running on your own data"):
   filter_mode     "paper" or "depth"; None = the settings' PeopleFilter.mode
   record_keypoints  fill FrameResult.kept_keypoints / removed_keypoints
   max_wait_for_mapping_ms  how long tracking may wait for local mapping (threaded mode)
-  wait_for_due_keyframes  mono: wait for every due keyframe (replays, as `crowdslam run`); False for a
+  replay_waits_for_mapping  mono: wait for every due keyframe (replays, as `crowdslam run`); False for a
                   live camera (as `--pace sensor`): only urgent keyframes are waited for
 
 Use it as a context manager: `with crowdslam.System(...) as slam:` shuts it down at the end of the block;
@@ -140,7 +140,7 @@ void bind_system(py::module_& m) {
            py::arg("vocabulary") = py::none(), py::arg("people_filter") = true, py::arg("detector") = py::none(),
            py::arg("detections") = py::none(), py::arg("sequential") = false, py::arg("loop_closing") = true,
            py::arg("filter_mode") = py::none(), py::arg("record_keypoints") = false,
-           py::arg("max_wait_for_mapping_ms") = 1000.0, py::arg("wait_for_due_keyframes") = true)
+           py::arg("max_wait_for_mapping_ms") = 1000.0, py::arg("replay_waits_for_mapping") = true)
       .def("track", &PySystem::track, py::arg("image"), py::arg("depth") = py::none(), py::arg("right") = py::none(),
            py::kw_only(), py::arg("timestamp"),
            "Tracks one frame. image: uint8 (H, W, 3) BGR or (H, W) grey; depth (rgbd): uint16 raw units\n"

@@ -3,12 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <unordered_set>
 
 #include "crowdslam/loop/keyframe_database.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/util/error.h"
-#include <unordered_set>
 
 namespace crowdslam::mapping {
 
@@ -16,7 +16,8 @@ void LocalMapperOptions::check() const {
   if (!(close_depth_m > 0)) throw InputError("local mapper: close depth must be > 0");
   if (max_local_ba_keyframes < 1) throw InputError("local mapper: max_local_ba_keyframes must be >= 1");
   if (triangulation_neighbours < 1) throw InputError("local mapper: triangulation_neighbours must be >= 1");
-  if (!(redundancy_ratio > 0 && redundancy_ratio <= 1)) throw InputError("local mapper: redundancy_ratio in (0, 1]");
+  if (!(redundancy_ratio > 0 && redundancy_ratio <= 1))
+    throw InputError("local mapper: redundancy_ratio in (0, 1]");
   if (!(delay_ms >= 0)) throw InputError("local mapper: delay_ms must be >= 0");
   ba.check();
 }
@@ -154,6 +155,14 @@ bool LocalMapper::wait_until_accepting(double timeout_ms) {
   return accepting_ && queue_.empty();
 }
 
+void LocalMapper::wait_until_points_made(uint64_t keyframe_id, double timeout_ms) {
+  std::unique_lock lock(queue_mutex_);
+  idle_cv_.wait_for(lock, std::chrono::duration<double, std::milli>(timeout_ms), [&] {
+    return (points_made_keyframe_id_ && *points_made_keyframe_id_ >= keyframe_id) ||
+           (accepting_ && queue_.empty()) || !worker_active_ || stop_requested_ || pause_requested_;
+  });
+}
+
 bool LocalMapper::has_new_keyframes() const { return queued_keyframes() > 0; }
 
 void LocalMapper::interrupt_bundle_adjustment() { abort_ba_ = true; }
@@ -162,6 +171,7 @@ void LocalMapper::reset() {
   {
     std::lock_guard lock(queue_mutex_);
     queue_.clear();
+    points_made_keyframe_id_.reset();
   }
   recent_points_.clear();
 }
@@ -177,7 +187,8 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
   };
   const auto start = Clock::now();
-  if (options_.delay_ms > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(options_.delay_ms));
+  if (options_.delay_ms > 0)
+    std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(options_.delay_ms));
   register_keyframe(keyframe);
   cull_recent_points(keyframe);
   const double register_ms = ms_since(start);
@@ -187,6 +198,11 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
   t = Clock::now();
   if (!has_new_keyframes()) fuse_with_neighbours(keyframe);
   const double fusion_ms = ms_since(t);
+  {
+    std::lock_guard lock(queue_mutex_);
+    points_made_keyframe_id_ = keyframe->id;
+  }
+  idle_cv_.notify_all();
   abort_ba_ = false;
   double culling_ms = 0;
   double ba_ms = 0;

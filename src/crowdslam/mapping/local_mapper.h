@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -29,7 +30,7 @@ namespace crowdslam::mapping {
 
 struct LocalMapperOptions {
   bool monocular = false;
-  double close_depth_m = 3.0;  // ThDepth in metres: only close points vote in keyframe culling
+  double close_depth_m = 3.0;         // ThDepth in metres: only close points vote in keyframe culling
   int triangulation_neighbours = 10;  // 20 for monocular
   double redundancy_ratio = 0.9;      // keyframe culling: fraction of points seen by 3+ other keyframes
   bool local_ba = true;
@@ -92,6 +93,7 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   [[nodiscard]] bool accepts_keyframes() const override;
   [[nodiscard]] size_t queued_keyframes() const override;
   bool wait_until_accepting(double timeout_ms) override;
+  void wait_until_points_made(uint64_t keyframe_id, double timeout_ms) override;
   void interrupt_bundle_adjustment() override;
   [[nodiscard]] bool is_paused() const override { return pause_requested_; }
 
@@ -139,6 +141,8 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   bool worker_active_ = false;  // the worker thread is running (queue_mutex_)
   std::condition_variable paused_cv_;
   std::condition_variable idle_cv_;  // the worker finished its queue and waits for keyframes
+  // The last keyframe whose new points are made (queue_mutex_; idle_cv_ is notified when it changes).
+  std::optional<uint64_t> points_made_keyframe_id_;
   std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done_;
   std::atomic<bool> accepting_{true};
   std::atomic<bool> abort_ba_{false};

@@ -68,7 +68,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracker_options.box_check_below = settings.people_filter.static_check_below;
   tracker_options.box_rescue = true;
   tracker_options.max_wait_for_mapping_ms = options.sequential ? 0.0 : options.max_wait_for_mapping_ms;
-  tracker_options.monocular_wait_for_due_keyframes = options.wait_for_due_keyframes;
+  tracker_options.monocular_replay_waits = options.replay_waits_for_mapping;
   tracker_options.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   if (options.sensor == io::SensorKind::kMonocular) {
     tracker_options.monocular = true;

@@ -40,10 +40,10 @@ struct SystemOptions {
   // Backpressure (tracking/tracker.h TrackerOptions::max_wait_for_mapping_ms): how long tracking may
   // wait for local mapping to take an urgently needed keyframe. 0 = never (ORB-SLAM2).
   double max_wait_for_mapping_ms = 1000.0;
-  // Monocular: also wait for keyframes that are due but not urgent (TrackerOptions::
-  // monocular_wait_for_due_keyframes). On for unpaced replays; `crowdslam run --pace sensor` turns it off,
-  // as a live camera would not wait.
-  bool wait_for_due_keyframes = true;
+  // Monocular: wait for local mapping as sequential mode would (every due keyframe, and the next frame for
+  // a keyframe's new points; TrackerOptions::monocular_replay_waits). On for unpaced replays; `crowdslam
+  // run --pace sensor` turns it off, as a live camera would not wait.
+  bool replay_waits_for_mapping = true;
   // Experiments and tests only: local mapping sleeps this long per keyframe (a slow mapper on demand).
   double mapper_delay_ms = 0;
 };

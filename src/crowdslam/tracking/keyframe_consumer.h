@@ -2,6 +2,7 @@
 // What tracking needs from local mapping, as an interface so tracking does not depend on the mapper
 // (and tests can substitute a sequential one).
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 
 namespace crowdslam::map {
@@ -21,6 +22,10 @@ class KeyframeConsumer {
   // passes. Returns accepts_keyframes(). Call without holding the map-update lock (the mapper takes it to
   // write bundle adjustment results back).
   virtual bool wait_until_accepting(double timeout_ms) = 0;
+  // Blocks until the mapper has made the new points of the keyframe with this id (triangulation and
+  // fusion; its local BA may still run), or, as wait_until_accepting, is idle, paused or stopped, or
+  // `timeout_ms` passes.
+  virtual void wait_until_points_made(uint64_t keyframe_id, double timeout_ms) = 0;
   // Asks a running local BA to stop early (a new keyframe is more useful).
   virtual void interrupt_bundle_adjustment() = 0;
   // True while the mapper is paused (e.g. loop correction): no keyframes are created then.

@@ -57,7 +57,7 @@ Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, K
 void Tracker::reset() {
   lost_frames_ = 0;
   last_tracked_s_.reset();
-  map_keyframe_before_next_frame_ = false;
+  next_frame_wait_ = NextFrameWait::kNone;
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
   last_box_frame_.reset();
@@ -87,13 +87,18 @@ void Tracker::start_in_loaded_map(bool localization_only) {
 TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
   TrackResult result;
   result.keypoints = static_cast<int>(frame.size());
-  if (map_keyframe_before_next_frame_) {
-    // The last frame tracked weakly and made a keyframe: this frame is tracked once that keyframe's points
-    // exist (triangulated and adjusted), as in sequential mode; otherwise it only sees the points of the
-    // keyframe before, one step late on motion that is already losing the map.
-    map_keyframe_before_next_frame_ = false;
+  if (next_frame_wait_ != NextFrameWait::kNone) {
+    // The last frame made a keyframe: this frame is tracked once that keyframe's points exist, as in
+    // sequential mode; otherwise it sees only the points of the keyframe before, one step late (in a
+    // turn, on motion that is already losing the map). After weak tracking it waits for the keyframe's
+    // local BA too; an unpaced replay waits for the new points only, and the BA runs while it tracks.
     const auto wait_start = std::chrono::steady_clock::now();
-    mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
+    if (next_frame_wait_ == NextFrameWait::kPointsMade && last_keyframe_) {
+      mapper_->wait_until_points_made(last_keyframe_->id, options_.max_wait_for_mapping_ms);
+    } else {
+      mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
+    }
+    next_frame_wait_ = NextFrameWait::kNone;
     result.waited_for_mapping_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
   }
@@ -245,8 +250,12 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       if (decision == KeyframeDecision::kInsert) {
         create_new_keyframe(frame);
         result.new_keyframe = true;
-        map_keyframe_before_next_frame_ = options_.monocular && options_.max_wait_for_mapping_ms > 0 &&
-                                          inliers_in_local_map_ < options_.monocular_weak_tracking_inliers;
+        if (options_.monocular && options_.max_wait_for_mapping_ms > 0) {
+          next_frame_wait_ = inliers_in_local_map_ < options_.monocular_weak_tracking_inliers
+                                 ? NextFrameWait::kMapped
+                             : options_.monocular_replay_waits ? NextFrameWait::kPointsMade
+                                                               : NextFrameWait::kNone;
+        }
       }
       // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
       frame.discard_outliers();

@@ -48,11 +48,14 @@ struct TrackerOptions {
   // rather than going on without new points, and the next frame waits until the mapper has mapped that
   // keyframe (docs/MAPPING.md, session 17). 0 = off.
   int monocular_weak_tracking_inliers = 100;
-  // Monocular, with max_wait_for_mapping_ms > 0: a keyframe that is due (the reference ratio) while the
-  // mapper is busy is waited for, not skipped, so that an unpaced replay makes the keyframes sequential
-  // mode makes and throughput follows the mapper's speed (issue 11). Off (a paced replay, a live camera):
-  // only urgent keyframes are waited for (overdue, weak tracking, under half the reference's points).
-  bool monocular_wait_for_due_keyframes = true;
+  // Monocular, with max_wait_for_mapping_ms > 0: an unpaced replay waits for local mapping as sequential
+  // mode would, so that it makes sequential mode's keyframes with its accuracy and throughput follows the
+  // mapper's speed (issue 11, docs/MAPPING.md session 18): a keyframe that is due (the reference ratio)
+  // while the mapper is busy is waited for, not skipped, and the frame after a keyframe waits until the
+  // mapper has made that keyframe's new points (its local BA then runs while the frame is tracked). Off
+  // (a paced replay, a live camera): only urgent keyframes are waited for (overdue, weak tracking, under
+  // half the reference's points).
+  bool monocular_replay_waits = true;
   // RGB-D / stereo with keyframe_reference_min_found = 0 (the default counts frames, below): the reference
   // keyframe's points counted for that ratio are those seen by at least this many keyframes (ORB-SLAM2:
   // 3; 2 while the map has two keyframes; monocular keeps 3). With 3, a
@@ -232,9 +235,13 @@ class Tracker {
   // when the keyframe has the frame's keypoints as they are.
   std::vector<long> last_keyframe_indices_;
   uint64_t last_relocalization_frame_id_ = 0;
-  bool map_keyframe_before_next_frame_ = false;  // a weak frame's keyframe: the next frame waits for it
-  int lost_frames_ = 0;                          // consecutive lost frames (new_map_after_lost_min_frames)
-  std::optional<double> last_tracked_s_;         // timestamp of the last tracked frame (new_map_after_lost_s)
+  // What the next frame waits for after a monocular keyframe (Tracker::track): nothing, the keyframe's
+  // new points (triangulation and fusion; an unpaced replay), or the whole mapping of it, local BA
+  // included (after weak tracking).
+  enum class NextFrameWait { kNone, kPointsMade, kMapped };
+  NextFrameWait next_frame_wait_ = NextFrameWait::kNone;
+  int lost_frames_ = 0;                   // consecutive lost frames (new_map_after_lost_min_frames)
+  std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
   int inliers_in_local_map_ = 0;
   bool map_loaded_ = false;
   bool localization_only_ = false;

@@ -192,7 +192,7 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
   // idle. No "close points" condition (there is no depth) and no insertion while the mapper is busy:
   // then its bundle adjustment is interrupted so that it becomes free sooner. Unlike ORB-SLAM2, tracking
   // waits for the busy mapper (backpressure) instead of going on without the keyframe: for every due
-  // keyframe in an unpaced replay (monocular_wait_for_due_keyframes), otherwise when the keyframe is
+  // keyframe in an unpaced replay (monocular_replay_waits), otherwise when the keyframe is
   // overdue (max_frames passed), the frame tracks less than half the reference's points, or it tracks
   // few points at all (weak tracking: a keyframe then even when its reference is as weak).
   constexpr double kReferenceRatio = 0.9;
@@ -220,7 +220,7 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
   if (!c2) return KeyframeDecision::kNo;
   if (mapper_idle && (c1a || c1b)) return KeyframeDecision::kInsert;
   mapper_->interrupt_bundle_adjustment();
-  const bool urgent = options_.monocular_wait_for_due_keyframes || c1a || weak ||
+  const bool urgent = options_.monocular_replay_waits || c1a || weak ||
                       inliers_in_local_map_ < reference_matches * kUrgentRatio;
   return urgent && options_.max_wait_for_mapping_ms > 0 ? KeyframeDecision::kWaitForMapper
                                                         : KeyframeDecision::kNo;
