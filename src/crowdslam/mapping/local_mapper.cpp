@@ -149,17 +149,19 @@ size_t LocalMapper::queued_keyframes() const {
 bool LocalMapper::wait_until_accepting(double timeout_ms) {
   std::unique_lock lock(queue_mutex_);
   // Sequential mode (no worker): keyframes are processed inline, so the mapper is idle whenever asked.
-  idle_cv_.wait_for(lock, std::chrono::duration<double, std::milli>(timeout_ms), [this] {
-    return (accepting_ && queue_.empty()) || !worker_active_ || stop_requested_ || pause_requested_;
-  });
+  idle_cv_.wait_for(lock, std::chrono::duration<double, std::milli>(timeout_ms),
+                    [this] { return idle_or_not_working(); });
   return accepting_ && queue_.empty();
+}
+
+bool LocalMapper::idle_or_not_working() const {
+  return (accepting_ && queue_.empty()) || !worker_active_ || stop_requested_ || pause_requested_;
 }
 
 void LocalMapper::wait_until_points_made(uint64_t keyframe_id, double timeout_ms) {
   std::unique_lock lock(queue_mutex_);
   idle_cv_.wait_for(lock, std::chrono::duration<double, std::milli>(timeout_ms), [&] {
-    return (points_made_keyframe_id_ && *points_made_keyframe_id_ >= keyframe_id) ||
-           (accepting_ && queue_.empty()) || !worker_active_ || stop_requested_ || pause_requested_;
+    return (points_made_keyframe_id_ && *points_made_keyframe_id_ >= keyframe_id) || idle_or_not_working();
   });
 }
 

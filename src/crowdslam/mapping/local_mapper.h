@@ -118,6 +118,8 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
 
  private:
   void run();
+  // The waits' common end (queue_mutex_ held): idle with an empty queue, or no worker, stopping or paused.
+  [[nodiscard]] bool idle_or_not_working() const;
   std::shared_ptr<map::KeyFrame> next_keyframe();
   void process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe);
   void register_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe);
