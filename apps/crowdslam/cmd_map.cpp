@@ -1,14 +1,19 @@
-// `crowdslam map info|export`: look into a saved map and export it for other tools.
+// `crowdslam map info|export|optimise`: look into a saved map, export it for other tools, refine it.
 #include <iostream>
 
 #include "commands.h"
 #include "crowdslam/mapdb/map_database.h"
 #include "crowdslam/mapdb/map_export.h"
+#include "crowdslam/system/map_optimise.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::app {
 
 namespace {
+nlohmann::json stats_json(const system::ReprojectionStats& s) {
+  return {{"observations", s.observations}, {"rms_px", s.rms_px}, {"median_px", s.median_px}, {"above_chi2", s.above_chi2}};
+}
+
 nlohmann::json info_json(const std::string& file, const mapdb::MapInfo& info) {
   const auto& id = info.header.identity;
   const auto& o = info.header.origin;
@@ -112,6 +117,39 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
         std::cout << "trajectory        " << doc["trajectory_poses"] << " poses -> " << args->trajectory << "\n";
       }
     }
+  });
+
+  struct OptimiseArgs {
+    std::string input, output;
+    system::MapOptimiseOptions options;
+  };
+  auto opt = std::make_shared<OptimiseArgs>();
+  auto* optimise = map_cmd->add_subcommand(
+      "optimise", "Global bundle adjustment of a saved map (every keyframe and point), written to a new map file");
+  optimise->add_option("file", opt->input, "Map database")->required();
+  optimise->add_option("--out", opt->output, "Map database to write (atomically)")->required();
+  optimise->add_option("--iterations", opt->options.iterations, "Levenberg-Marquardt iterations")
+      ->capture_default_str();
+  optimise->add_flag("--overwrite", opt->options.overwrite, "Replace an existing output file (it may be the input)");
+  optimise->callback([opt, &global] {
+    const auto r = system::optimise_saved_map(opt->input, opt->output, opt->options);
+    const nlohmann::json doc = {{"file", opt->input},       {"out", opt->output},
+                                {"keyframes", r.keyframes}, {"map_points", r.map_points},
+                                {"iterations", r.iterations}, {"initial_cost", r.initial_cost},
+                                {"final_cost", r.final_cost}, {"before", stats_json(r.before)},
+                                {"after", stats_json(r.after)}, {"time_ms", r.time_ms}};
+    if (global.json) {
+      print_json(doc);
+      return;
+    }
+    std::cout << "map               " << opt->input << ": " << r.keyframes << " keyframes, " << r.map_points
+              << " points, " << r.before.observations << " observations\n"
+              << "reprojection      rms " << r.before.rms_px << " px -> " << r.after.rms_px << " px, median "
+              << r.before.median_px << " -> " << r.after.median_px << " px, above chi2 " << r.before.above_chi2
+              << " -> " << r.after.above_chi2 << "\n"
+              << "cost              " << r.initial_cost << " -> " << r.final_cost << " (" << r.iterations
+              << " iterations, " << static_cast<int>(r.time_ms) << " ms)\n"
+              << "written           " << opt->output << "\n";
   });
 }
 

@@ -80,6 +80,17 @@ TEST(CliMap, BadMapFilesAndOptionsExitOneWithTheFileNamed) {
   EXPECT_FALSE(std::filesystem::exists(dir / "p.ply"));
   const auto nothing = run_cli({"map", "export", junk.string()});
   EXPECT_EQ(nothing.exit_code, 1);
+  // map optimise: a bad input or option names it and writes nothing.
+  const auto optimised = dir / "optimised.db";
+  const auto bad_input = run_cli({"map", "optimise", junk.string(), "--out", optimised.string()});
+  EXPECT_EQ(bad_input.exit_code, 1);
+  EXPECT_NE(bad_input.err.find("junk.db"), std::string::npos) << bad_input.err;
+  const auto bad_iterations =
+      run_cli({"map", "optimise", junk.string(), "--out", optimised.string(), "--iterations", "0"});
+  EXPECT_EQ(bad_iterations.exit_code, 1);
+  EXPECT_NE(bad_iterations.err.find("--iterations"), std::string::npos) << bad_iterations.err;
+  EXPECT_FALSE(std::filesystem::exists(optimised));
+  EXPECT_TRUE(temporaries(dir.path()).empty());
   const auto dataset = synth_small(dir, 5);
   const auto localization = run_cli({"run", "--dataset", dataset.string(), "--out", (dir / "o").string(), "--localization"});
   EXPECT_EQ(localization.exit_code, 1);

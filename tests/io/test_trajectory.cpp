@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "crowdslam/io/trajectory.h"
@@ -242,6 +243,22 @@ TEST(TrajectoryFormat, DetectedFromContent) {
   EXPECT_DOUBLE_EQ(io::read_trajectory((dir / "euroc_header.csv").string())[0].timestamp_s, 5e-9);
   EXPECT_EQ(io::read_trajectory((dir / "kitti.txt").string())[0].timestamp_s, 0.0);
   EXPECT_EQ(io::read_trajectory((dir / "tum_commas.txt").string())[0].timestamp_s, 1.5);
+}
+
+TEST(TrajectoryFormat, KittiPosesTakeTheirStampsFromTimesTxtBesideThem) {
+  TempDir dir;
+  const std::string pose = "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  std::filesystem::create_directories(dir / "seq");
+  write_text(dir / "seq" / "poses.txt", pose + pose + pose);
+  write_text(dir / "seq" / "times.txt", "0.000000e+00\n1.036330e-01\n2.072460e-01\n");
+  const Trajectory t = io::read_trajectory((dir / "seq" / "poses.txt").string());
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_DOUBLE_EQ(t[1].timestamp_s, 0.103633);
+  EXPECT_DOUBLE_EQ(t[2].timestamp_s, 0.207246);
+  // A times.txt that does not match the poses is an error naming both counts, not a silent mismatch.
+  write_text(dir / "seq" / "times.txt", "0\n0.1\n");
+  const std::string poses = (dir / "seq" / "poses.txt").string();
+  expect_input_error([&] { io::read_trajectory(poses); }, poses + ": 3 poses but 2 timestamps");
 }
 
 TEST(TrajectoryFormat, WriteTrajectoryDispatchesAndReadBackMatches) {

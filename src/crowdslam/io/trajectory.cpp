@@ -3,8 +3,12 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <filesystem>
 #include <string_view>
 
+#include <spdlog/spdlog.h>
+
+#include "crowdslam/io/dataset_list.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
@@ -197,8 +201,17 @@ Trajectory read_trajectory(const std::string& path) {
   switch (detect_trajectory_format(path)) {
     case TrajectoryFormat::kEuroc:
       return read_euroc_trajectory(path);
-    case TrajectoryFormat::kKitti:
-      return read_kitti_trajectory(path);
+    case TrajectoryFormat::kKitti: {
+      // KITTI layout: poses.txt beside times.txt, one line each per frame.
+      const auto times = std::filesystem::path(path).parent_path() / "times.txt";
+      if (!std::filesystem::is_regular_file(times)) {
+        spdlog::warn("{}: KITTI poses without a times.txt beside them: the line index is the timestamp", path);
+        return read_kitti_trajectory(path);
+      }
+      std::vector<double> stamps;
+      for (const auto& entry : read_times_list(times.string())) stamps.push_back(entry.timestamp_s);
+      return read_kitti_trajectory(path, stamps);
+    }
     case TrajectoryFormat::kTum:
       break;
   }

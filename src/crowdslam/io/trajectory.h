@@ -24,7 +24,9 @@ Trajectory read_tum_trajectory(const std::string& path);
 // else the line index.
 Trajectory read_kitti_trajectory(const std::string& path, const std::vector<double>& timestamps = {});
 Trajectory read_euroc_trajectory(const std::string& path);
-// Picks the reader by content (EuRoC: ns stamps and commas; KITTI: 12 fields; TUM: 8 fields).
+// Picks the reader by content (EuRoC: ns stamps and commas; KITTI: 12 fields; TUM: 8 fields). A KITTI file
+// takes its timestamps from the times.txt beside it (the KITTI layout; a count that differs is an
+// InputError), else the line index (with a warning).
 Trajectory read_trajectory(const std::string& path);
 // The format read_trajectory() would pick: EuRoC when a '#' header names "[ns]" or the first data line
 // has commas, at least 8 fields and a stamp >= 1e11 (nanoseconds); else KITTI for 12 fields; else TUM

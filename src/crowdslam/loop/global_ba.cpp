@@ -180,6 +180,9 @@ bool GlobalBundleAdjuster::optimise_and_apply() {
   ++stats_.runs;
   ++stats_.applied;
   stats_.time_ms_total += total_ms;
+  stats_.last_initial_cost = result.initial_cost;
+  stats_.last_final_cost = result.final_cost;
+  stats_.last_iterations = result.iterations;
   return true;
 }
 

@@ -26,6 +26,10 @@ struct GlobalBaStats {
   int aborted = 0;
   int applied = 0;
   double time_ms_total = 0;
+  // Of the last adjustment that ran to the end (robust cost, chi2 units; solver iterations).
+  double last_initial_cost = 0;
+  double last_final_cost = 0;
+  int last_iterations = 0;
 };
 
 class GlobalBundleAdjuster {
