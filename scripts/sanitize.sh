@@ -253,6 +253,8 @@ run_sanitizer() {
     run_step "$tag map info/export" "$out/map_export.log" \
       "$bin" map export "$out/bonn2.db" --ply "$out/bonn2.ply" --keyframes "$out/bonn2_kf.ply" \
       --trajectory "$out/bonn2_kf.txt" || true
+    run_step "$tag map optimise" "$out/map_optimise.log" \
+      "$bin" map optimise "$out/bonn2.db" --out "$out/bonn2_opt.db" --iterations 5 --overwrite || true
     # The detector decoupled from tracking (YOLOX ONNX, boxes moved by optical flow between detections,
     # the box tracker): the detection worker takes the newest frame while tracking goes on.
     if [[ -f "$shared/models/yolox-nano/yolox_nano.onnx" ]]; then
