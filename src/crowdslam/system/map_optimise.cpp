@@ -13,6 +13,7 @@
 #include "crowdslam/map/map.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/mapdb/map_database.h"
+#include "crowdslam/optim/bundle_adjustment.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::system {
@@ -23,9 +24,8 @@ void MapOptimiseOptions::check() const {
 
 namespace {
 
-constexpr double kChi2Mono = 5.991;  // 95 % of a 2-dof chi-square, as local and global BA use
-
 ReprojectionStats reprojection_stats(const map::Map& map) {
+  const double chi2_mono = optim::BundleAdjustmentOptions{}.chi2_mono;  // the threshold BA classifies with
   std::unordered_map<uint64_t, std::shared_ptr<map::KeyFrame>> keyframes;
   for (auto& kf : map.keyframes()) {
     if (!kf->is_bad()) keyframes[kf->id] = kf;
@@ -33,6 +33,7 @@ ReprojectionStats reprojection_stats(const map::Map& map) {
   std::vector<double> errors;
   ReprojectionStats stats;
   double sum2 = 0;
+  size_t in_front = 0;
   for (const auto& point : map.map_points()) {
     if (point->is_bad()) continue;
     const geometry::Vec3 world = point->world();
@@ -45,14 +46,16 @@ ReprojectionStats reprojection_stats(const map::Map& map) {
       const double e2 = c.z() <= 0 ? std::numeric_limits<double>::infinity()
                                    : (kf.camera->project(c) - geometry::Vec2(key.pt.x, key.pt.y)).squaredNorm();
       errors.push_back(std::sqrt(e2));
-      if (std::isfinite(e2)) sum2 += e2;
-      if (!(e2 * kf.levels->inv_sigma2[key.octave] <= kChi2Mono)) ++stats.above_chi2;
+      if (std::isfinite(e2)) {
+        sum2 += e2;
+        ++in_front;
+      }
+      if (!(e2 * kf.levels->inv_sigma2[key.octave] <= chi2_mono)) ++stats.above_chi2;
     }
   }
   stats.observations = errors.size();
   if (errors.empty()) return stats;
-  const size_t finite = static_cast<size_t>(std::count_if(errors.begin(), errors.end(), [](double e) { return std::isfinite(e); }));
-  stats.rms_px = finite ? std::sqrt(sum2 / static_cast<double>(finite)) : 0.0;
+  stats.rms_px = in_front ? std::sqrt(sum2 / static_cast<double>(in_front)) : 0.0;
   auto mid = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
   std::nth_element(errors.begin(), mid, errors.end());
   stats.median_px = *mid;
