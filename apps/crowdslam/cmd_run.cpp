@@ -98,6 +98,10 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
       "on (default): keypoints and map points that move against the estimated camera motion are kept "
       "out of tracking and mapping, with or without the people filter; off: the check is skipped "
       "(Geometry.dynamic_check)");
+  cmd->add_option("--ground", args->options.ground,
+                  "on: a monocular camera at a constant height above the ground (a car's); the run ends with a "
+                  "global BA that holds each keyframe's ground at one height, against scale drift; off: not "
+                  "(Ground.enabled; config/KITTI*.yaml turn it on)");
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
   cmd->add_option(

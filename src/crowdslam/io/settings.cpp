@@ -106,6 +106,8 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.integer("Geometry.region_steps"), s.geometry.region_steps);
   set_if(r.integer("Geometry.free_space_cull_run"), s.geometry.free_space_cull_run);
   set_if(r.integer("Tracking.odometry_bridge_min_inliers"), s.tracking.odometry_bridge_min_inliers);
+  set_if(r.flag("Ground.enabled"), s.ground.enabled);
+  set_if(r.real("Ground.keyframe_sigma"), s.ground.keyframe_sigma);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
   set_if(r.reals("FeatureBudget.thresholds"), s.feature_budget.thresholds);
   set_if(r.reals("FeatureBudget.factors"), s.feature_budget.factors);
@@ -202,7 +204,8 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.feature_budget.factors == b.feature_budget.factors &&
                       a.feature_budget.area == b.feature_budget.area;
   const bool tracking = a.tracking.odometry_bridge_min_inliers == b.tracking.odometry_bridge_min_inliers;
-  return camera && orb && detector && people && geometry && tracking && budget && a.th_depth == b.th_depth &&
+  const bool ground = a.ground.enabled == b.ground.enabled && a.ground.keyframe_sigma == b.ground.keyframe_sigma;
+  return camera && orb && detector && people && geometry && tracking && ground && budget && a.th_depth == b.th_depth &&
          a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&
          a.has_baseline == b.has_baseline && a.output.trajectory_format == b.output.trajectory_format &&
          same_rectification(a.rectification, b.rectification);

@@ -135,6 +135,15 @@ struct TrackingSettings {
   int odometry_bridge_min_inliers = 50;
 };
 
+// A monocular camera that rides at a constant height above planar ground (on a car or a ground robot):
+// global BA (the final one of a completed run, and those after loop closures) holds each keyframe's
+// ground at one height, which takes out the scale drift of monocular mapping (geometry/ground_plane.h,
+// docs/MAPPING.md). Not for handheld or flying cameras. Stereo and RGB-D have their scale and ignore it.
+struct GroundSettings {
+  bool enabled = false;
+  double keyframe_sigma = 0.01;  // a keyframe's height sigma, relative to the map's ground height
+};
+
 struct FeatureBudgetSettings {
   bool enabled = true;
   std::vector<double> thresholds{0.0, 0.3, 0.6, 0.9, 0.95};
@@ -160,6 +169,7 @@ struct Settings {
   PeopleFilterSettings people_filter;
   GeometrySettings geometry;
   TrackingSettings tracking;
+  GroundSettings ground;
   FeatureBudgetSettings feature_budget;
   OutputSettings output;
   // Which camera the file describes, whatever sensor it was loaded for: DepthMapFactor present = an

@@ -226,6 +226,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
             "in [1, 8]", g.free_space_cull_run);
   c.require(s.tracking.odometry_bridge_min_inliers >= 0, "Tracking.odometry_bridge_min_inliers", ">= 0 (0 = off)",
             s.tracking.odometry_bridge_min_inliers);
+  c.require(std::isfinite(s.ground.keyframe_sigma) && s.ground.keyframe_sigma > 0 && s.ground.keyframe_sigma <= 1,
+            "Ground.keyframe_sigma", "in (0, 1] (relative to the camera's height)", s.ground.keyframe_sigma);
   const auto& b = s.feature_budget;
   if (b.thresholds.empty()) c.fail("FeatureBudget.thresholds", "must not be empty");
   for (std::size_t i = 0; i < b.thresholds.size(); ++i) {

@@ -79,6 +79,8 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Geometry.free_space_ratio",
                                   "Geometry.free_space_cull_run",
                                   "Tracking.odometry_bridge_min_inliers",
+                                  "Ground.enabled",
+                                  "Ground.keyframe_sigma",
                                   "FeatureBudget.enabled",
                                   "FeatureBudget.thresholds",
                                   "FeatureBudget.factors",

@@ -123,6 +123,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nGeometry.free_space_cull_run: " << g.free_space_cull_run << "\n\n";
   out << "# Tracking through views the map does not cover (RGB-D / stereo)\nTracking.odometry_bridge_min_inliers: "
       << s.tracking.odometry_bridge_min_inliers << "\n\n";
+  out << "# A monocular camera at a constant height above the ground (a car's)\nGround.enabled: "
+      << (s.ground.enabled ? 1 : 0) << "\nGround.keyframe_sigma: " << real_text(s.ground.keyframe_sigma) << "\n\n";
   const auto& b = s.feature_budget;
   out << "# Feature budget: factor on nFeatures by fraction of the image covered by "
          "people\nFeatureBudget.enabled: "

@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <unordered_map>
 
@@ -16,6 +18,11 @@ GlobalBundleAdjuster::GlobalBundleAdjuster(std::shared_ptr<map::Map> map, LocalM
     : map_(std::move(map)), mapper_(mapper), iterations_(iterations) {}
 
 GlobalBundleAdjuster::~GlobalBundleAdjuster() { abort(); }
+
+void GlobalBundleAdjuster::set_ground(const geometry::GroundPlaneOptions& options) {
+  options.check();
+  ground_ = options;
+}
 
 void GlobalBundleAdjuster::launch() {
   abort();
@@ -79,6 +86,43 @@ std::vector<std::shared_ptr<map::KeyFrame>> tree_order(const std::vector<std::sh
 
 }  // namespace
 
+std::vector<optim::BaPlaneConstraint> GlobalBundleAdjuster::ground_constraints(
+    const std::vector<std::shared_ptr<map::KeyFrame>>& keyframes, const std::vector<std::shared_ptr<map::MapPoint>>& points) {
+  std::unordered_map<const map::MapPoint*, int> point_index;
+  for (size_t k = 0; k < points.size(); ++k) point_index[points[k].get()] = static_cast<int>(k);
+  // Each keyframe's points in its camera frame, and their index among `points`.
+  std::vector<std::vector<geometry::Vec3>> in_camera(keyframes.size());
+  std::vector<std::vector<int>> index(keyframes.size());
+  for (size_t i = 0; i < keyframes.size(); ++i) {
+    const geometry::SE3 cam_from_world = keyframes[i]->cam_from_world();
+    for (const auto& p : keyframes[i]->valid_map_points()) {
+      const auto it = point_index.find(p.get());
+      if (it == point_index.end()) continue;
+      in_camera[i].push_back(cam_from_world * p->world());
+      index[i].push_back(it->second);
+    }
+  }
+  std::vector<optim::BaPlaneConstraint> planes;
+  const auto ground = geometry::estimate_ground(in_camera, *ground_);
+  if (ground) {
+    for (size_t i = 0; i < keyframes.size(); ++i) {
+      const auto& plane = ground->planes[i];
+      if (!plane) continue;
+      // n points at sigma * sqrt(n) each: the keyframe's height at keyframe_sigma, however many it has.
+      const double sigma =
+          ground_->keyframe_sigma * std::sqrt(static_cast<double>(plane->inliers.size())) * ground->height;
+      for (size_t j : plane->inliers) planes.push_back({static_cast<int>(i), index[i][j], plane->normal, ground->height, sigma});
+    }
+  }
+  const int with_ground = ground ? ground->keyframes_with_ground() : 0;
+  spdlog::info("global BA: the ground under {} of {} keyframes ({} points)", with_ground, keyframes.size(), planes.size());
+  std::lock_guard lock(stats_mutex_);
+  stats_.ground_keyframes = with_ground;
+  stats_.ground_points = static_cast<int>(planes.size());
+  stats_.ground_height = ground ? ground->height : 0.0;
+  return planes;
+}
+
 bool GlobalBundleAdjuster::optimise_and_apply() {
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::shared_ptr<map::KeyFrame>> keyframes;
@@ -117,12 +161,14 @@ bool GlobalBundleAdjuster::optimise_and_apply() {
       observations.push_back(o);
     }
   }
+  std::vector<optim::BaPlaneConstraint> planes;
+  if (ground_) planes = ground_constraints(keyframes, points);
   optim::BundleAdjustmentOptions options;
   options.first_pass_iterations = iterations_;
   options.second_pass_iterations = 0;
   options.num_threads = 1;
   const auto result = optim::local_bundle_adjustment(*keyframes.front()->camera, ba_keyframes, ba_points,
-                                                     observations, options, &abort_);
+                                                     observations, options, &abort_, planes);
   const double optimise_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (result.aborted || abort_) {
     std::lock_guard lock(stats_mutex_);

@@ -38,6 +38,7 @@ LoopCloser::LoopCloser(const LoopCloserOptions& options, std::shared_ptr<map::Ma
       detector_(options.consistency_threshold),
       global_ba_(map_, mapper, options.global_ba_iterations) {
   options_.check();
+  if (options_.ground) global_ba_.set_ground(*options_.ground);
 }
 
 LoopCloser::~LoopCloser() { stop(); }

@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -42,6 +43,8 @@ struct LoopCloserOptions {
   int essential_graph_iterations = 20;
   bool global_ba = true;
   int global_ba_iterations = 10;
+  // Monocular on a vehicle (io::GroundSettings): global BA also holds the ground under each keyframe.
+  std::optional<geometry::GroundPlaneOptions> ground;
   void check() const;
 };
 

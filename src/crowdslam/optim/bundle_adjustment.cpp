@@ -53,6 +53,8 @@ class AbortCallback final : public ceres::IterationCallback {
   const std::atomic<bool>* flag_;
 };
 
+constexpr double kPlaneHuberDelta = 1.0;  // plane residuals are in sigmas: linear beyond one sigma
+
 bool aborted(const std::atomic<bool>* flag) {
   return flag != nullptr && flag->load(std::memory_order_relaxed);
 }
@@ -63,10 +65,12 @@ struct BaState {
   std::vector<Vec3> points;
   std::vector<int> obs_keyframe;
   std::vector<int> obs_point;
+  std::vector<int> plane_keyframe;  // per plane constraint, as obs_keyframe / obs_point
+  std::vector<int> plane_point;
 };
 
 BaState make_state(const std::vector<BaKeyframe>& keyframes, const std::vector<BaPoint>& points,
-                   const std::vector<BaObservation>& observations) {
+                   const std::vector<BaObservation>& observations, const std::vector<BaPlaneConstraint>& planes) {
   BaState state;
   std::unordered_map<int, int> keyframe_index;
   std::unordered_map<int, int> point_index;
@@ -89,6 +93,13 @@ BaState make_state(const std::vector<BaKeyframe>& keyframes, const std::vector<B
     state.obs_keyframe.push_back(known ? k->second : -1);
     state.obs_point.push_back(known ? p->second : -1);
   }
+  for (const BaPlaneConstraint& plane : planes) {
+    const auto k = keyframe_index.find(plane.keyframe_id);
+    const auto p = point_index.find(plane.point_id);
+    const bool known = k != keyframe_index.end() && p != point_index.end();
+    state.plane_keyframe.push_back(known ? k->second : -1);
+    state.plane_point.push_back(known ? p->second : -1);
+  }
   return state;
 }
 
@@ -100,11 +111,12 @@ ceres::LinearSolverType linear_solver_type(BaLinearSolver choice) {
 class BaSolver {
  public:
   BaSolver(const PinholeCamera& camera, const std::vector<BaKeyframe>& keyframes,
-           const std::vector<BaObservation>& observations, const BundleAdjustmentOptions& options,
-           BaState& state)
+           const std::vector<BaObservation>& observations, const std::vector<BaPlaneConstraint>& planes,
+           const BundleAdjustmentOptions& options, BaState& state)
       : camera_(camera),
         keyframes_(keyframes),
         observations_(observations),
+        planes_(planes),
         options_(options),
         state_(state) {}
 
@@ -173,6 +185,18 @@ class BaSolver {
       o.huber_delta = robust ? std::sqrt(o.stereo ? options_.chi2_stereo : options_.chi2_mono) : 0.0;
       observations.push_back(o);
     }
+    for (std::size_t i = 0; i < planes_.size(); ++i) {
+      if (state_.plane_keyframe[i] < 0) continue;
+      SchurObservation o;
+      o.pose = state_.plane_keyframe[i];
+      o.point = state_.plane_point[i];
+      o.plane = true;
+      o.normal = planes_[i].normal_cam;
+      o.distance = planes_[i].distance;
+      o.sqrt_information = 1.0 / planes_[i].sigma;
+      o.huber_delta = kPlaneHuberDelta;
+      observations.push_back(o);
+    }
     const SchurLmSummary summary =
         solve_schur_lm(camera_, poses, fixed, state_.points, observations, iterations, abort_flag);
     for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -214,6 +238,20 @@ class BaSolver {
                                  robust ? &mono_loss : nullptr, pose, point);
       }
     }
+    ceres::HuberLoss plane_loss(kPlaneHuberDelta);
+    for (std::size_t i = 0; i < planes_.size(); ++i) {
+      const int k = state_.plane_keyframe[i];
+      const int p = state_.plane_point[i];
+      if (k < 0 || !point_used[p]) continue;  // a plane alone does not make a point optimisable
+      double* pose = state_.poses[k].data();
+      if (!pose_used[k]) {
+        problem.AddParameterBlock(pose, 7, &manifold_);
+        if (keyframes_[k].fixed) problem.SetParameterBlockConstant(pose);
+        pose_used[k] = true;
+      }
+      problem.AddResidualBlock(new PlaneDistanceCost(planes_[i].normal_cam, planes_[i].distance, planes_[i].sigma),
+                               &plane_loss, pose, state_.points[p].data());
+    }
     ceres::Solver::Summary summary;
     if (problem.NumResidualBlocks() == 0) return summary;
 
@@ -240,6 +278,7 @@ class BaSolver {
   const PinholeCamera& camera_;
   const std::vector<BaKeyframe>& keyframes_;
   const std::vector<BaObservation>& observations_;
+  const std::vector<BaPlaneConstraint>& planes_;
   const BundleAdjustmentOptions& options_;
   BaState& state_;
   Se3Manifold manifold_;
@@ -252,7 +291,8 @@ BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera,
                                                const std::vector<BaPoint>& points,
                                                const std::vector<BaObservation>& observations,
                                                const BundleAdjustmentOptions& options,
-                                               const std::atomic<bool>* abort_flag) {
+                                               const std::atomic<bool>* abort_flag,
+                                               const std::vector<BaPlaneConstraint>& planes) {
   BundleAdjustmentResult result;
   result.keyframes = keyframes;
   result.points = points;
@@ -260,8 +300,8 @@ BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera,
     result.aborted = true;
     return result;
   }
-  BaState state = make_state(keyframes, points, observations);
-  BaSolver solver(camera, keyframes, observations, options, state);
+  BaState state = make_state(keyframes, points, observations, planes);
+  BaSolver solver(camera, keyframes, observations, planes, options, state);
 
   std::vector<bool> active(observations.size());
   for (std::size_t i = 0; i < observations.size(); ++i) active[i] = state.obs_keyframe[i] >= 0;

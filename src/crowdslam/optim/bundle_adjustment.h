@@ -41,6 +41,17 @@ struct BaObservation {
   [[nodiscard]] bool is_stereo() const { return right_u >= 0.0; }
 };
 
+// A point known to lie on a plane seen from a keyframe (the ground under a vehicle's camera:
+// mapping/ground_plane.h): residual (normal_cam . (cam_from_world * point) - distance) / sigma, Huber loss
+// with delta 1 in both passes. Never an outlier and never erased; unknown ids are skipped.
+struct BaPlaneConstraint {
+  int keyframe_id = -1;
+  int point_id = -1;
+  geometry::Vec3 normal_cam = geometry::Vec3::UnitY();  // unit normal in the keyframe's camera frame
+  double distance = 0.0;  // of the plane from the camera centre, map units
+  double sigma = 1.0;     // map units
+};
+
 enum class BaLinearSolver {
   kAuto,         // kOwnSchur up to kOwnSchurMaxFreePoses free poses (local windows), else Ceres kSparseSchur
   kSparseSchur,  // Ceres SPARSE_SCHUR; falls back to DENSE_SCHUR when no sparse backend is compiled in
@@ -80,7 +91,8 @@ BundleAdjustmentResult local_bundle_adjustment(const geometry::PinholeCamera& ca
                                                const std::vector<BaPoint>& points,
                                                const std::vector<BaObservation>& observations,
                                                const BundleAdjustmentOptions& options = {},
-                                               const std::atomic<bool>* abort_flag = nullptr);
+                                               const std::atomic<bool>* abort_flag = nullptr,
+                                               const std::vector<BaPlaneConstraint>& planes = {});
 
 // Whether this Ceres build has a sparse linear algebra backend (SuiteSparse, CXSparse, Eigen...).
 bool ceres_has_sparse_backend();

@@ -122,4 +122,18 @@ bool StereoReprojectionCost::Evaluate(double const* const* parameters, double* r
   return true;
 }
 
+PlaneDistanceCost::PlaneDistanceCost(const Vec3& normal_cam, double distance, double sigma)
+    : normal_(normal_cam), distance_(distance), inv_sigma_(1.0 / sigma) {}
+
+bool PlaneDistanceCost::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const ConstQuaternionMap q(parameters[0]);
+  const Vec3 p_cam = q * ConstVec3Map(parameters[1]) + ConstVec3Map(parameters[0] + 4);
+  residuals[0] = inv_sigma_ * (normal_.dot(p_cam) - distance_);
+  if (jacobians != nullptr) {
+    const Eigen::Matrix<double, 1, 3> d = inv_sigma_ * normal_.transpose();
+    write_jacobians<1>(d, p_cam, q, jacobians);
+  }
+  return true;
+}
+
 }  // namespace crowdslam::optim

@@ -70,4 +70,17 @@ class StereoReprojectionCost final : public ceres::SizedCostFunction<3, 7, 3> {
   double sqrt_information_;
 };
 
+// Residual (normal . (cam_from_world * point) - distance) / sigma: a point on a plane given in the camera
+// frame (BaPlaneConstraint); blocks: pose (7), point (3).
+class PlaneDistanceCost final : public ceres::SizedCostFunction<1, 7, 3> {
+ public:
+  PlaneDistanceCost(const geometry::Vec3& normal_cam, double distance, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  geometry::Vec3 normal_;
+  double distance_;
+  double inv_sigma_;
+};
+
 }  // namespace crowdslam::optim

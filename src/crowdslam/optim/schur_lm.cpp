@@ -48,6 +48,10 @@ class Problem {
   bool residual(const Mat3& rotation, const SE3& pose, const Vec3& point, const SchurObservation& o, Vec3& r,
                 Vec3& p_cam) const {
     p_cam = rotation * point + pose.translation();
+    if (o.plane) {
+      r << o.sqrt_information * (o.normal.dot(p_cam) - o.distance), 0.0, 0.0;
+      return true;
+    }
     if (std::abs(p_cam.z()) < kMinAbsDepth) return false;
     const double inv_z = 1.0 / p_cam.z();
     const double u = camera_.fx * p_cam.x() * inv_z + camera_.cx;
@@ -74,6 +78,11 @@ class Problem {
   // d r / d p_cam (whitened; third row 0 for mono).
   [[nodiscard]] Mat3 d_residual(const SchurObservation& o, const Vec3& p_cam) const {
     Mat3 d;
+    if (o.plane) {
+      d.setZero();
+      d.row(0) = o.normal.transpose();
+      return o.sqrt_information * d;
+    }
     d.topRows<2>() = projection_jacobian(camera_.fx, camera_.fy, p_cam);
     if (o.stereo) {
       d.row(2) = right_u_jacobian(camera_.fx, camera_.bf, p_cam);

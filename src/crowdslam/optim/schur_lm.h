@@ -11,6 +11,7 @@
 //
 // The problem and the schedule are the same as with Ceres:
 //   cost = 1/2 sum rho(|r_i|^2), r_i = sqrt(inv_sigma2) * (projection - observation) (2 or 3 rows),
+//   or, for a plane constraint, sqrt_information * (normal . p_cam - distance) (1 row),
 //   rho = Huber with delta^2 = the chi2 threshold (robust pass) or identity;
 //   poses are cam_from_world, updated by left perturbation (optim::left_update), points by addition;
 //   LM with Marquardt's diagonal scaling (H + mu diag(H), diag clamped to [1e-6, 1e32]), Nielsen's
@@ -34,6 +35,11 @@ struct SchurObservation {
   double sqrt_information = 1.0;
   bool stereo = false;
   double huber_delta = 0.0;  // 0: no robust loss
+  // A plane constraint instead of a reprojection: residual sqrt_information * (normal . p_cam - distance)
+  // (one row; pixel, right_u and stereo unused).
+  bool plane = false;
+  geometry::Vec3 normal = geometry::Vec3::Zero();
+  double distance = 0.0;
 };
 
 struct SchurLmSummary {

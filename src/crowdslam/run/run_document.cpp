@@ -89,6 +89,24 @@ nlohmann::json segment_json(const system::MapSegment& s) {
           {"keyframes", s.keyframes}};
 }
 
+// Null when the ground is not held (not monocular, or Ground.enabled 0).
+nlohmann::json ground_json(const system::System& slam) {
+  if (!slam.ground()) return nullptr;
+  nlohmann::json doc = {{"keyframe_sigma", slam.ground()->keyframe_sigma}, {"final_global_ba", nullptr}};
+  if (const auto& f = slam.final_ground_ba()) {
+    doc["final_global_ba"] = {{"applied", f->applied},
+                              {"keyframes", f->keyframes},
+                              {"keyframes_with_ground", f->stats.ground_keyframes},
+                              {"ground_points", f->stats.ground_points},
+                              {"ground_height", f->stats.ground_height},
+                              {"initial_cost", f->stats.last_initial_cost},
+                              {"final_cost", f->stats.last_final_cost},
+                              {"iterations", f->stats.last_iterations},
+                              {"time_ms", f->stats.time_ms_total}};
+  }
+  return doc;
+}
+
 void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary) {
   std::vector<double> tracking_ms, extraction_ms, total_ms;
   for (const auto& r : reports) {
@@ -286,6 +304,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                          {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
                                          {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
                         : nlohmann::json(nullptr);
+  doc["ground"] = ground_json(slam);
   const auto& g = s.geometry;
   doc["geometry"] = {{"dynamic_check", g.dynamic_check},
                      {"moving_factor", g.moving_factor},

@@ -127,6 +127,12 @@ Prepared prepare(const RunOptions& options) {
     }
     p.run_settings.geometry.dynamic_check = options.geometry == "on";
   }
+  if (!options.ground.empty()) {
+    if (options.ground != "on" && options.ground != "off") {
+      throw InputError("--ground: expected 'on' or 'off', got '" + clip_text(options.ground, 60) + "'");
+    }
+    p.run_settings.ground.enabled = options.ground == "on";
+  }
   if (p.sensor == io::SensorKind::kStereo) prepare_stereo_settings(*p.source, p.run_settings);
   check_first_frame(*p.source, p.settings);
   return p;

@@ -47,6 +47,7 @@ struct RunOptions {
   int detector_interval = 0;         // --detector-interval: overrides Detector.latest_interval (0 = keep)
   std::string box_tracker;           // --box-tracker: overrides Detector.tracker (on | off)
   std::string geometry;              // --geometry: overrides Geometry.dynamic_check (on | off)
+  std::string ground;                // --ground: overrides Ground.enabled (on | off)
   size_t save_frames = 0;            // --save-frames N: every N-th frame drawn into OUT/frames/
   std::string vocabulary;            // --vocabulary FILE | none ("" = the default vocabulary)
   bool loop_closing = true;          // --no-loop-closing

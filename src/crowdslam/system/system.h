@@ -22,6 +22,13 @@
 
 namespace crowdslam::system {
 
+// The global BA with the ground that ends a completed monocular run on a vehicle (Ground.enabled).
+struct FinalGroundBa {
+  bool applied = false;  // false: fewer than 2 keyframes, or no map points (stats.ground_keyframes: 0 = no ground found)
+  int keyframes = 0;
+  loop::GlobalBaStats stats;  // time, costs, keyframes with ground, ground points, ground height
+};
+
 struct SystemOptions {
   io::SensorKind sensor = io::SensorKind::kRgbd;
   bool sequential = false;  // local mapping inline after each frame: reproducible runs
@@ -160,6 +167,11 @@ class System {
   [[nodiscard]] mapping::LocalMapperStats mapper_stats() const;
   // Empty statistics when loop closing is off.
   [[nodiscard]] loop::LoopCloserStats loop_stats() const;
+  // The ground held in global BA (monocular with Ground.enabled; io::GroundSettings), else empty.
+  [[nodiscard]] const std::optional<geometry::GroundPlaneOptions>& ground() const { return ground_; }
+  // The global BA with the ground that ends a completed run (shutdown()); empty until it ran, and when
+  // there is no ground to hold.
+  [[nodiscard]] const std::optional<FinalGroundBa>& final_ground_ba() const { return final_ground_ba_; }
   [[nodiscard]] bool loop_closing_enabled() const { return loop_closer_ != nullptr; }
   [[nodiscard]] int map_resets() const { return map_resets_; }
   [[nodiscard]] bool people_filter_enabled() const { return people_ != nullptr; }
@@ -212,6 +224,8 @@ class System {
   int map_resets_ = 0;
   std::optional<mapdb::MapOrigin> loaded_map_origin_;
   std::optional<std::chrono::steady_clock::time_point> last_snapshot_;
+  std::optional<geometry::GroundPlaneOptions> ground_;
+  std::optional<FinalGroundBa> final_ground_ba_;
   bool shut_down_ = false;
 };
 
