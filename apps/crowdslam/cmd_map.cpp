@@ -131,13 +131,19 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
   optimise->add_option("--iterations", opt->options.iterations, "Levenberg-Marquardt iterations")
       ->capture_default_str();
   optimise->add_flag("--overwrite", opt->options.overwrite, "Replace an existing output file (it may be the input)");
+  optimise->add_option("--ground", opt->options.ground_sigma,
+                       "A monocular map of a camera at a constant height above the ground (a car's): also hold "
+                       "each keyframe's ground at one height, with this relative sigma per keyframe (as "
+                       "Ground.keyframe_sigma, e.g. 0.01; 0 = off)");
   optimise->callback([opt, &global] {
     const auto r = system::optimise_saved_map(opt->input, opt->output, opt->options);
     const nlohmann::json doc = {{"file", opt->input},       {"out", opt->output},
                                 {"keyframes", r.keyframes}, {"map_points", r.map_points},
                                 {"iterations", r.iterations}, {"initial_cost", r.initial_cost},
                                 {"final_cost", r.final_cost}, {"before", stats_json(r.before)},
-                                {"after", stats_json(r.after)}, {"time_ms", r.time_ms}};
+                                {"after", stats_json(r.after)}, {"time_ms", r.time_ms},
+                                {"keyframes_with_ground", r.keyframes_with_ground},
+                                {"ground_points", r.ground_points}};
     if (global.json) {
       print_json(doc);
       return;
@@ -148,7 +154,12 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
               << r.before.median_px << " -> " << r.after.median_px << " px, above chi2 " << r.before.above_chi2
               << " -> " << r.after.above_chi2 << "\n"
               << "cost              " << r.initial_cost << " -> " << r.final_cost << " (" << r.iterations
-              << " iterations, " << static_cast<int>(r.time_ms) << " ms)\n"
+              << " iterations, " << static_cast<int>(r.time_ms) << " ms)\n";
+    if (opt->options.ground_sigma > 0) {
+      std::cout << "ground            under " << r.keyframes_with_ground << " of " << r.keyframes << " keyframes ("
+                << r.ground_points << " points)\n";
+    }
+    std::cout
               << "written           " << opt->output << "\n";
   });
 }

@@ -89,6 +89,9 @@ TEST(CliMap, BadMapFilesAndOptionsExitOneWithTheFileNamed) {
       run_cli({"map", "optimise", junk.string(), "--out", optimised.string(), "--iterations", "0"});
   EXPECT_EQ(bad_iterations.exit_code, 1);
   EXPECT_NE(bad_iterations.err.find("--iterations"), std::string::npos) << bad_iterations.err;
+  const auto bad_ground = run_cli({"map", "optimise", junk.string(), "--out", optimised.string(), "--ground", "-0.5"});
+  EXPECT_EQ(bad_ground.exit_code, 1);
+  EXPECT_NE(bad_ground.err.find("--ground"), std::string::npos) << bad_ground.err;
   EXPECT_FALSE(std::filesystem::exists(optimised));
   EXPECT_TRUE(temporaries(dir.path()).empty());
   const auto dataset = synth_small(dir, 5);

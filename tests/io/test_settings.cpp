@@ -82,6 +82,8 @@ TEST(ShippedSettings, KittiFilesHaveThePublishedCalibration) {
     EXPECT_DOUBLE_EQ(s.camera.fps, 10.0);
     EXPECT_DOUBLE_EQ(s.th_depth, 35.0);
     EXPECT_EQ(s.orb.n_features, 2000);
+    EXPECT_TRUE(s.ground.enabled);  // a car's camera: monocular runs hold the ground
+    EXPECT_DOUBLE_EQ(s.ground.keyframe_sigma, 0.01);
   }
 }
 
@@ -140,6 +142,8 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.feature_budget.factors = {1.0, 1.25, 3.0};
   s.output.trajectory_format = "kitti";
   s.tracking.odometry_bridge_min_inliers = 0;
+  s.ground.enabled = true;
+  s.ground.keyframe_sigma = 0.1 + 0.2;
   TempDir dir;
   const std::string path = (dir / "out.yaml").string();
   write_settings(path, s);
@@ -150,6 +154,8 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   EXPECT_EQ(back.detector.resize, "letterbox");
   EXPECT_EQ(back.camera.k1, 0.1 + 0.2);
   EXPECT_EQ(back.tracking.odometry_bridge_min_inliers, 0);
+  EXPECT_TRUE(back.ground.enabled);
+  EXPECT_EQ(back.ground.keyframe_sigma, 0.1 + 0.2);
   // A monocular settings object without rectification also survives.
   Settings mono = load_settings(config("TUM3.yaml"), SensorKind::kMonocular);
   write_settings(path, mono);
@@ -175,6 +181,8 @@ TEST(Settings, OwnSectionsTakeDefaultsWhenAbsent) {
   EXPECT_EQ(s.feature_budget.factors.size(), 6u);
   EXPECT_EQ(s.output.trajectory_format, "tum");
   EXPECT_EQ(s.tracking.odometry_bridge_min_inliers, 50);
+  EXPECT_FALSE(s.ground.enabled);
+  EXPECT_DOUBLE_EQ(s.ground.keyframe_sigma, 0.01);
 }
 
 TEST(Settings, FeatureBudgetFactorTable) {
@@ -296,6 +304,9 @@ INSTANTIATE_TEST_SUITE_P(
                  "Tracking.odometry_bridge_min_inliers: must be >= 0 (0 = off)"},
         BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.odometry_bridge_min_inliers: 1.5",
                  "Tracking.odometry_bridge_min_inliers: expected an integer"},
+        BadValue{"Detector.nms", "Detector.nms: 0.1\nGround.keyframe_sigma: 0",
+                 "Ground.keyframe_sigma: must be in (0, 1] (relative to the camera's height)"},
+        BadValue{"Detector.nms", "Detector.nms: 0.1\nGround.enabled: 2", "Ground.enabled: expected 0 or 1"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: [ 0.0, 0.6, 0.3, 0.9, 0.95 ]",
                  "FeatureBudget.thresholds: must be strictly increasing"},
         BadValue{"FeatureBudget.thresholds", "FeatureBudget.thresholds: 0.5",

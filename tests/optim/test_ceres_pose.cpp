@@ -85,6 +85,29 @@ TEST(CeresPose, StereoCostJacobiansMatchNumeric) {
   }
 }
 
+TEST(CeresPose, PlaneCostJacobiansMatchNumeric) {
+  std::mt19937 rng(3);
+  const PinholeCamera camera = test_camera();
+  for (int trial = 0; trial < 5; ++trial) {
+    const SE3 pose = random_pose(rng);
+    const Vec3 point = random_visible_point(camera, pose, 1.0, 6.0, rng);
+    const PlaneDistanceCost cost(random_unit(rng), 1.65, 0.05);
+    EXPECT_LT(max_jacobian_error<1>(cost, to_pose_block(pose), point), 1e-6);
+  }
+}
+
+TEST(CeresPose, PlaneResidualIsTheDistanceInSigmas) {
+  // Camera at the origin looking along z, a point 2 m ahead and 1.5 m down; the plane y = 1.65 under the
+  // camera: the point is 0.15 m above it, -3 sigmas at sigma 0.05.
+  const PlaneDistanceCost cost(Vec3::UnitY(), 1.65, 0.05);
+  PoseBlock block = to_pose_block(SE3());
+  const Vec3 point(0.3, 1.5, 2.0);
+  const double* parameters[] = {block.data(), point.data()};
+  double residual[1];
+  ASSERT_TRUE(cost.Evaluate(parameters, residual, nullptr));
+  EXPECT_NEAR(residual[0], -3.0, 1e-9);
+}
+
 TEST(CeresPose, StereoResidualIsWeightedError) {
   const PinholeCamera camera = test_camera();
   const SE3 pose;

@@ -1,9 +1,9 @@
 // Monocular SLAM on real forward motion (issue 11): KITTI odometry 07, the first 100 frames (a car
 // accelerating to 8.5 m/s through a town), in sequential mode so the run is reproducible. The map is
 // initialised once and never reset, every frame is tracked (those before the initialisation localised in
-// the new map afterwards), and the Sim3 ATE
-// stays within 0.65 % of the 54 m travelled (the issue's target for the threaded mode is 0.5 %, 0.27 m:
-// not met yet, see docs/RESULTS.md).
+// the new map afterwards), and the Sim3 ATE over every frame stays within the issue's 0.5 % of the 54 m
+// travelled (0.27 m), with the ground held in the final global BA (config/KITTI04-12.yaml,
+// Ground.enabled); without the ground the scale drift of the slow turn makes it 0.30 m (docs/MAPPING.md).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -45,9 +45,56 @@ TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
     EXPECT_TRUE(frames[i]["localized_after_init"].get<bool>()) << i;
   }
   ASSERT_TRUE(summary.ate_rmse_m.has_value());
-  EXPECT_LT(*summary.ate_rmse_m, 0.35);
-  std::printf("[ measured ] kitti07_head sequential: %zu/%zu tracked, ATE %.3f m, %d keyframes\n", summary.tracked,
-              summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>());
+  EXPECT_LT(*summary.ate_rmse_m, 0.27);  // measured 0.17 m
+  // The final global BA held the ground under most keyframes.
+  const auto& ground = summary.json["ground"];
+  ASSERT_TRUE(ground.is_object());
+  const auto& final_ba = ground["final_global_ba"];
+  ASSERT_TRUE(final_ba.is_object());
+  EXPECT_TRUE(final_ba["applied"].get<bool>());
+  EXPECT_GT(final_ba["keyframes_with_ground"].get<int>(), final_ba["keyframes"].get<int>() / 2);
+  EXPECT_GT(final_ba["ground_points"].get<int>(), 10 * final_ba["keyframes_with_ground"].get<int>());
+  EXPECT_LT(final_ba["final_cost"].get<double>(), final_ba["initial_cost"].get<double>());
+  std::printf("[ measured ] kitti07_head sequential: %zu/%zu tracked, ATE %.3f m, %d keyframes, ground under %d\n",
+              summary.tracked, summary.frames, *summary.ate_rmse_m, summary.json["summary"]["keyframes"].get<int>(),
+              final_ba["keyframes_with_ground"].get<int>());
+}
+
+// The same run without the ground (--ground off): the same tracking, no final adjustment, and the scale
+// drift of the turn left in (measured 0.30 m against 0.17 m).
+TEST(RunKitti, WithoutTheGroundTheScaleDriftOfTheTurnStays) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  run::RunOptions options;
+  options.dataset = test::shared_data("kitti07_head").string();
+  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
+  options.sensor = io::SensorKind::kMonocular;
+  options.sequential = true;
+  options.progress = false;
+  options.people_filter = false;
+  double ate[2] = {0, 0};
+  for (int on = 0; on < 2; ++on) {
+    options.ground = on ? "on" : "off";
+    options.out_dir = (tmp / options.ground).string();
+    const auto summary = run::run_sequence(options);
+    ASSERT_TRUE(summary.ate_rmse_m.has_value());
+    EXPECT_EQ(summary.tracked, summary.frames);
+    EXPECT_EQ(summary.json["ground"].is_null(), on == 0);
+    ate[on] = *summary.ate_rmse_m;
+  }
+  EXPECT_GT(ate[0], 0.27);
+  EXPECT_LT(ate[1], 0.75 * ate[0]);
+  std::printf("[ measured ] kitti07_head sequential: ATE %.3f m without the ground, %.3f m with it\n", ate[0], ate[1]);
+  // A value other than on/off names the option.
+  options.ground = "maybe";
+  options.out_dir = (tmp / "bad").string();
+  try {
+    (void)run::run_sequence(options);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("--ground"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad" / "run.json"));
 }
 
 namespace {

@@ -20,6 +20,10 @@ namespace crowdslam::system {
 
 void MapOptimiseOptions::check() const {
   if (iterations < 1) throw InputError("map optimise: --iterations must be >= 1, got " + std::to_string(iterations));
+  if (!(ground_sigma >= 0 && ground_sigma <= 1)) {
+    throw InputError("map optimise: --ground must be in [0, 1] (a keyframe's height sigma, relative; 0 = off), got " +
+                     std::to_string(ground_sigma));
+  }
 }
 
 namespace {
@@ -87,11 +91,18 @@ MapOptimiseReport optimise_saved_map(const std::filesystem::path& input, const s
   }
   report.before = reprojection_stats(*map);
   loop::GlobalBundleAdjuster adjuster(map, nullptr, options.iterations);
+  if (options.ground_sigma > 0) {
+    geometry::GroundPlaneOptions ground;
+    ground.keyframe_sigma = options.ground_sigma;
+    adjuster.set_ground(ground);
+  }
   if (!adjuster.run()) throw InputError(input.string() + ": map optimise: the map has no points to optimise");
   const auto stats = adjuster.stats();
   report.iterations = stats.last_iterations;
   report.initial_cost = stats.last_initial_cost;
   report.final_cost = stats.last_final_cost;
+  report.keyframes_with_ground = stats.ground_keyframes;
+  report.ground_points = stats.ground_points;
   report.after = reprojection_stats(*map);
   mapdb::save_map(output, *map, header);
   report.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

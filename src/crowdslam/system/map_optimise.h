@@ -6,7 +6,8 @@
 //
 // Use it to refine a map before reusing it (--load-map), or to ask what the map's measurements alone say:
 // the optimum of the reprojection error over the whole map, independent of the order and the windows in
-// which local mapping optimised it (docs/MAPPING.md "Session 20" uses it that way).
+// which local mapping optimised it (docs/MAPPING.md "Session 20" uses it that way). With --ground, the
+// global BA a monocular run on a car ends with (Ground.enabled), applied to a saved map.
 #include <cstddef>
 #include <filesystem>
 
@@ -15,6 +16,9 @@ namespace crowdslam::system {
 struct MapOptimiseOptions {
   int iterations = 20;  // Levenberg-Marquardt iterations, >= 1
   bool overwrite = false;  // replace an existing output file (which may be the input)
+  // A monocular map of a camera at a constant height above the ground (a car's, --ground): also hold each
+  // keyframe's ground at one height, with this relative sigma per keyframe (0 = off; io::GroundSettings).
+  double ground_sigma = 0.0;
 
   // Throws InputError naming the bad option.
   void check() const;
@@ -37,6 +41,8 @@ struct MapOptimiseReport {
   double initial_cost = 0;       // robust cost (chi2 units)
   double final_cost = 0;
   double time_ms = 0;
+  int keyframes_with_ground = 0;  // with ground_sigma: keyframes whose ground was held
+  int ground_points = 0;
 };
 
 // Reads `input`, optimises, writes `output` atomically (a failure leaves no output and any old file as it
