@@ -150,3 +150,30 @@ TEST(RunKitti, SequentialRgbdRunsWithThePeopleFilterGiveByteIdenticalTrajectorie
   EXPECT_TRUE(files[0] == files[2]) << "camera trajectories differ between two sequential runs";
   EXPECT_TRUE(files[1] == files[3]) << "keyframe trajectories differ between two sequential runs";
 }
+
+// Localising in a saved map of a car's camera changes nothing of the map: no final global BA with the
+// ground (it would move the keyframes the poses are expressed through); a mapping run in it does.
+TEST(RunKitti, LocalisationInASavedMapRunsNoFinalAdjustment) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  run::RunOptions options;
+  options.dataset = test::shared_data("kitti07_head").string();
+  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
+  options.sensor = io::SensorKind::kMonocular;
+  options.sequential = true;
+  options.progress = false;
+  options.people_filter = false;
+  options.max_frames = 30;
+  options.out_dir = (tmp / "map").string();
+  options.save_map = (tmp / "k.db").string();
+  const auto mapping = run::run_sequence(options);
+  ASSERT_TRUE(mapping.json["ground"]["final_global_ba"].is_object());
+  options.out_dir = (tmp / "loc").string();
+  options.save_map.clear();
+  options.load_map = (tmp / "k.db").string();
+  options.localization = true;
+  const auto localisation = run::run_sequence(options);
+  EXPECT_GT(localisation.tracked, 25u);
+  ASSERT_TRUE(localisation.json["ground"].is_object());
+  EXPECT_TRUE(localisation.json["ground"]["final_global_ba"].is_null());
+}

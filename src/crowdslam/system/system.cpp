@@ -167,7 +167,7 @@ void System::shutdown() {
   shut_down_ = true;
   mapper_->stop();
   if (loop_closer_) loop_closer_->stop();  // after the mapper: it may still hand over keyframes
-  if (ground_) {
+  if (ground_ && !localization_only()) {  // a map only localised in is left as it was loaded
     // All threads have stopped: the map is final but for this adjustment. Frames follow their keyframes.
     loop::GlobalBundleAdjuster adjuster(map_, nullptr, kFinalGroundBaIterations);
     adjuster.set_ground(*ground_);

@@ -169,8 +169,8 @@ class System {
   [[nodiscard]] loop::LoopCloserStats loop_stats() const;
   // The ground held in global BA (monocular with Ground.enabled; io::GroundSettings), else empty.
   [[nodiscard]] const std::optional<geometry::GroundPlaneOptions>& ground() const { return ground_; }
-  // The global BA with the ground that ends a completed run (shutdown()); empty until it ran, and when
-  // there is no ground to hold.
+  // The global BA with the ground that ends a completed run (shutdown()); empty until it ran, when there
+  // is no ground to hold, and in localisation mode (the loaded map is not changed).
   [[nodiscard]] const std::optional<FinalGroundBa>& final_ground_ba() const { return final_ground_ba_; }
   [[nodiscard]] bool loop_closing_enabled() const { return loop_closer_ != nullptr; }
   [[nodiscard]] int map_resets() const { return map_resets_; }
