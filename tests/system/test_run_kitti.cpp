@@ -17,17 +17,25 @@
 
 using namespace crowdslam;
 
-TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
-  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
-  test::TempDir tmp;
+namespace {
+// kitti07_head, monocular, sequential (reproducible), no people filter, the shipped KITTI settings.
+run::RunOptions kitti_sequential() {
   run::RunOptions options;
   options.dataset = test::shared_data("kitti07_head").string();
   options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
-  options.out_dir = (tmp / "out").string();
   options.sensor = io::SensorKind::kMonocular;
   options.sequential = true;
   options.progress = false;
   options.people_filter = false;
+  return options;
+}
+}  // namespace
+
+TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
+  CROWDSLAM_REQUIRE_SHARED("kitti07_head");
+  test::TempDir tmp;
+  run::RunOptions options = kitti_sequential();
+  options.out_dir = (tmp / "out").string();
   const auto summary = run::run_sequence(options);
   ASSERT_TRUE(summary.init_frame.has_value());
   EXPECT_LE(*summary.init_frame, 10u);
@@ -65,13 +73,7 @@ TEST(RunKitti, MonocularForwardMotionInitialisesOnceAndKeepsTrack) {
 TEST(RunKitti, WithoutTheGroundTheScaleDriftOfTheTurnStays) {
   CROWDSLAM_REQUIRE_SHARED("kitti07_head");
   test::TempDir tmp;
-  run::RunOptions options;
-  options.dataset = test::shared_data("kitti07_head").string();
-  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
-  options.sensor = io::SensorKind::kMonocular;
-  options.sequential = true;
-  options.progress = false;
-  options.people_filter = false;
+  run::RunOptions options = kitti_sequential();
   double ate[2] = {0, 0};
   for (int on = 0; on < 2; ++on) {
     options.ground = on ? "on" : "off";
@@ -122,13 +124,7 @@ std::array<std::string, 4> two_sequential_runs(run::RunOptions options, const te
 TEST(RunKitti, SequentialRunsGiveByteIdenticalTrajectories) {
   CROWDSLAM_REQUIRE_SHARED("kitti07_head");
   test::TempDir tmp;
-  run::RunOptions options;
-  options.dataset = test::shared_data("kitti07_head").string();
-  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
-  options.sensor = io::SensorKind::kMonocular;
-  options.sequential = true;
-  options.progress = false;
-  options.people_filter = false;
+  run::RunOptions options = kitti_sequential();
   options.max_frames = 40;
   const auto files = two_sequential_runs(options, tmp);
   EXPECT_GT(files[0].size(), 1000u);
@@ -156,13 +152,7 @@ TEST(RunKitti, SequentialRgbdRunsWithThePeopleFilterGiveByteIdenticalTrajectorie
 TEST(RunKitti, LocalisationInASavedMapRunsNoFinalAdjustment) {
   CROWDSLAM_REQUIRE_SHARED("kitti07_head");
   test::TempDir tmp;
-  run::RunOptions options;
-  options.dataset = test::shared_data("kitti07_head").string();
-  options.settings_path = (test::source_dir() / "config" / "KITTI04-12.yaml").string();
-  options.sensor = io::SensorKind::kMonocular;
-  options.sequential = true;
-  options.progress = false;
-  options.people_filter = false;
+  run::RunOptions options = kitti_sequential();
   options.max_frames = 30;
   options.out_dir = (tmp / "map").string();
   options.save_map = (tmp / "k.db").string();
