@@ -11,8 +11,6 @@
 
 namespace crowdslam::geometry {
 
-
-
 void GroundPlaneOptions::check() const {
   auto fail = [](const std::string& what) { return InputError("ground plane: " + what); };
   if (!(max_tilt_deg > 0 && max_tilt_deg < 90)) throw fail("max_tilt_deg must be in (0, 90)");
@@ -46,6 +44,31 @@ std::vector<std::size_t> candidates_below(const std::vector<Vec3>& points, const
     if (p.z() > 0 && p.y() > options.min_below_ratio * p.z()) candidates.push_back(i);
   }
   return candidates;
+}
+
+// The height (distance along `normal`) that most candidates lie at, within ratio of it; 0 when fewer than
+// min_inliers do.
+double height_mode(const std::vector<Vec3>& points, const std::vector<std::size_t>& candidates, const Vec3& normal,
+                   double ratio, int min_inliers) {
+  std::vector<double> heights;
+  for (std::size_t i : candidates) {
+    const double h = normal.dot(points[i]);
+    if (h > 0) heights.push_back(h);
+  }
+  std::sort(heights.begin(), heights.end());
+  std::size_t best_count = 0;
+  double best = 0;
+  std::size_t lo = 0;
+  std::size_t hi = 0;
+  for (const double h : heights) {
+    while (heights[lo] < h * (1 - ratio)) ++lo;
+    while (hi < heights.size() && heights[hi] <= h * (1 + ratio)) ++hi;
+    if (hi - lo > best_count) {
+      best_count = hi - lo;
+      best = h;
+    }
+  }
+  return best_count >= static_cast<std::size_t>(min_inliers) ? best : 0.0;
 }
 
 }  // namespace
@@ -123,35 +146,6 @@ std::optional<Vec3> consensus_normal(const std::vector<Vec3>& normals, double ma
   }
   return sum.normalized();
 }
-
-namespace {
-
-// The height (distance along `normal`) that most candidates lie at, within ratio of it; 0 when fewer than
-// min_inliers do.
-double height_mode(const std::vector<Vec3>& points, const std::vector<std::size_t>& candidates, const Vec3& normal,
-                   double ratio, int min_inliers) {
-  std::vector<double> heights;
-  for (std::size_t i : candidates) {
-    const double h = normal.dot(points[i]);
-    if (h > 0) heights.push_back(h);
-  }
-  std::sort(heights.begin(), heights.end());
-  std::size_t best_count = 0;
-  double best = 0;
-  std::size_t lo = 0;
-  std::size_t hi = 0;
-  for (const double h : heights) {
-    while (heights[lo] < h * (1 - ratio)) ++lo;
-    while (hi < heights.size() && heights[hi] <= h * (1 + ratio)) ++hi;
-    if (hi - lo > best_count) {
-      best_count = hi - lo;
-      best = h;
-    }
-  }
-  return best_count >= static_cast<std::size_t>(min_inliers) ? best : 0.0;
-}
-
-}  // namespace
 
 std::optional<GroundPlane> ground_along_normal(const std::vector<Vec3>& points_cam, const Vec3& normal,
                                                const GroundPlaneOptions& options) {
