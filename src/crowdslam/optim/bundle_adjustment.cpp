@@ -86,19 +86,17 @@ BaState make_state(const std::vector<BaKeyframe>& keyframes, const std::vector<B
     (void)inserted;
     state.points.push_back(points[i].world);
   }
-  for (const BaObservation& obs : observations) {
-    const auto k = keyframe_index.find(obs.keyframe_id);
-    const auto p = point_index.find(obs.point_id);
+  // Ids to state indices; -1 for both when either id is unknown (the residual is skipped).
+  auto resolve = [&](int keyframe_id, int point_id, std::vector<int>& keyframe_out, std::vector<int>& point_out) {
+    const auto k = keyframe_index.find(keyframe_id);
+    const auto p = point_index.find(point_id);
     const bool known = k != keyframe_index.end() && p != point_index.end();
-    state.obs_keyframe.push_back(known ? k->second : -1);
-    state.obs_point.push_back(known ? p->second : -1);
-  }
+    keyframe_out.push_back(known ? k->second : -1);
+    point_out.push_back(known ? p->second : -1);
+  };
+  for (const BaObservation& obs : observations) resolve(obs.keyframe_id, obs.point_id, state.obs_keyframe, state.obs_point);
   for (const BaPlaneConstraint& plane : planes) {
-    const auto k = keyframe_index.find(plane.keyframe_id);
-    const auto p = point_index.find(plane.point_id);
-    const bool known = k != keyframe_index.end() && p != point_index.end();
-    state.plane_keyframe.push_back(known ? k->second : -1);
-    state.plane_point.push_back(known ? p->second : -1);
+    resolve(plane.keyframe_id, plane.point_id, state.plane_keyframe, state.plane_point);
   }
   return state;
 }
