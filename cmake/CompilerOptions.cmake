@@ -19,8 +19,9 @@ endif()
 # Helper: a library target for one folder of src/crowdslam.
 #   crowdslam_add_library(NAME io SOURCES a.cpp b.cpp DEPS crowdslam_util OpenCV...)
 #   Without SOURCES, every *.cpp in the calling folder is compiled (CONFIGURE_DEPENDS glob).
+#   NO_PCH: no precompiled header (a library without Eigen and OpenCV among its dependencies).
 function(crowdslam_add_library)
-  cmake_parse_arguments(ARG "" "NAME" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_PCH" "NAME" "SOURCES;DEPS" ${ARGN})
   set(target crowdslam_${ARG_NAME})
   if(NOT ARG_SOURCES)
     file(GLOB ARG_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
@@ -30,6 +31,11 @@ function(crowdslam_add_library)
     target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
     target_link_libraries(${target} PUBLIC ${ARG_DEPS})
     crowdslam_target_options(${target})
+    if(ARG_NO_PCH)
+      crowdslam_speed_up(${target} LIBRARY NO_PCH)
+    else()
+      crowdslam_speed_up(${target} LIBRARY)
+    endif()
   else()
     add_library(${target} INTERFACE)
     target_include_directories(${target} INTERFACE ${PROJECT_SOURCE_DIR}/src)
@@ -39,12 +45,12 @@ function(crowdslam_add_library)
 endfunction()
 
 # Helper: one GoogleTest executable per module, registered with CTest.
-#   crowdslam_add_test(NAME io SOURCES test_x.cpp DEPS crowdslam::io LABELS unit [SERIAL regex])
+#   crowdslam_add_test(NAME io SOURCES test_x.cpp DEPS crowdslam::io LABELS unit [SERIAL regex] [NO_PCH])
 #   Without SOURCES, every test_*.cpp in the calling folder. Tests whose name matches SERIAL run alone
 #   (RUN_SERIAL): threaded runs whose outcome depends on how the mapper keeps up, so that `ctest -j`
 #   neighbours do not take their cores.
 function(crowdslam_add_test)
-  cmake_parse_arguments(ARG "" "NAME;SERIAL" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_PCH" "NAME;SERIAL" "SOURCES;DEPS;LABELS" ${ARGN})
   set(target test_${ARG_NAME})
   if(NOT ARG_SOURCES)
     file(GLOB ARG_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp)
@@ -55,6 +61,11 @@ function(crowdslam_add_test)
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE ${ARG_DEPS} crowdslam_test_support GTest::gtest_main)
   crowdslam_target_options(${target})
+  if(ARG_NO_PCH)
+    crowdslam_speed_up(${target} TEST NO_PCH)
+  else()
+    crowdslam_speed_up(${target} TEST)
+  endif()
   gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60)
   # Labels (module name + e.g. e2e) are set after discovery: passing a list through
   # gtest_discover_tests(PROPERTIES LABELS ...) keeps only its first element with CMake 3.25.

@@ -17,7 +17,7 @@ matched to ground-truth poses by timestamp (within 0.02 s); the camera comes fro
 3. --write-groundtruth-map OUT.db: a copy of the map whose keyframe poses are the ground truth (moved into
    the map's frame and scale by the inverse of that Sim(3)) and whose points are the triangulated ones.
    `crowdslam map optimise OUT.db --out OPT.db` then shows where the map's measurements alone lead from
-   the true poses (docs/MAPPING.md "Session 20").
+   the true poses (docs/MAPPING.md "How to measure").
 Exit 1 with a message for a missing or malformed input.
 """
 import argparse

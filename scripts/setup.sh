@@ -1,10 +1,18 @@
 #!/usr/bin/env bash
 # Installs what crowdslam needs from Debian 12 packages (only what is missing), then configures and
 # builds it. Idempotent: a second run with nothing changed only runs the (no-op) incremental build.
-#   scripts/setup.sh [BUILD_DIR] [extra cmake args...]
+#   scripts/setup.sh [--target T]... [BUILD_DIR] [extra cmake args...]
+# --target builds only that CMake target and what it needs (scripts/demo.sh: --target crowdslam, the
+# CLI); without it everything is built: libraries, CLI, tests, benchmarks and the Python module.
 # Environment: CROWDSLAM_BUILD_TYPE (default Release), CROWDSLAM_JOBS (default: number of cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+targets=()
+while [[ "${1:-}" == "--target" ]]; do
+  [[ -n "${2:-}" ]] || { echo "setup: error: --target needs a target name" >&2; exit 1; }
+  targets+=(--target "$2")
+  shift 2
+done
 build_dir="${1:-build}"
 shift || true
 
@@ -39,8 +47,12 @@ if [[ ! -f "$build_dir/build.ninja" ]]; then
   echo "setup: configuring $build_dir (cmake)"
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="${CROWDSLAM_BUILD_TYPE:-Release}" "$@"
 fi
-echo "setup: building with $jobs jobs (ninja shows [done/total]; a first build takes 10-15 minutes on 2 cores)"
-cmake --build "$build_dir" -j "$jobs"
+if ((${#targets[@]})); then
+  echo "setup: building ${targets[*]} with $jobs jobs (ninja shows [done/total])"
+else
+  echo "setup: building everything with $jobs jobs (ninja shows [done/total])"
+fi
+cmake --build "$build_dir" -j "$jobs" "${targets[@]}"
 echo "setup: default vocabulary and person-detector models"
 
 # Default ORB vocabulary (vocabulary/crowdslam_orb.voc, never committed): trained from opencv-doc's

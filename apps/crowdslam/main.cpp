@@ -12,6 +12,7 @@
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/interrupt.h"
 #include "crowdslam/util/text.h"
+#include "crowdslam/util/version.h"
 
 namespace crowdslam::app {
 namespace {
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("crowdslam"));
   crowdslam::install_cleanup_handlers();  // a signal never leaves a temporary file behind
   CLI::App app{"crowdslam: visual SLAM that keeps working in crowds"};
-  app.set_version_flag("--version", std::string("crowdslam ") + CROWDSLAM_VERSION);
+  app.set_version_flag("--version", crowdslam::version_line());
   app.require_subcommand(1);
   GlobalOptions global;
   app.add_flag("--json", global.json, "Machine-readable JSON output on stdout");

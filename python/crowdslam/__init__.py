@@ -15,12 +15,12 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._core import Detector, FrameResult, InputError, Settings, __version__, set_log_level
+from ._core import Detector, FrameResult, InputError, Settings, __git_commit__, __version__, set_log_level
 from . import datasets, eval  # noqa: A004 (crowdslam.eval, as `crowdslam eval`)
 
 __all__ = [
     "Detector", "FrameResult", "InputError", "Keyframes", "MapPoints", "Settings", "System", "datasets", "eval",
-    "set_log_level", "__version__",
+    "set_log_level", "__version__", "__git_commit__",
 ]
 
 

@@ -10,6 +10,7 @@ from . import datasets as datasets
 from . import eval as eval
 
 __version__: str
+__git_commit__: str
 PathLike = Union[str, "os.PathLike[str]"]
 
 class InputError(ValueError):

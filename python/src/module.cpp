@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/version.h"
 #include "py_bindings.h"
 
 namespace py = pybind11;
@@ -12,7 +13,8 @@ namespace py = pybind11;
 PYBIND11_MODULE(_core, m) {
   using namespace crowdslam::python;
   m.doc() = "crowdslam: visual SLAM for crowded places (native part; import crowdslam instead)";
-  m.attr("__version__") = CROWDSLAM_VERSION;
+  m.attr("__version__") = crowdslam::version();
+  m.attr("__git_commit__") = crowdslam::git_commit();
 
   // Every user-input error of the library (files, settings, arguments) arrives as one exception type with
   // the message the CLI would print. A ValueError, so `except ValueError` catches bad input generally.

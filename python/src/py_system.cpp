@@ -11,6 +11,7 @@
 
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
+#include "crowdslam/util/version.h"
 #include "py_arrays.h"
 #include "py_gil.h"
 
@@ -251,7 +252,7 @@ void PySystem::save_map(const std::string& path, const std::string& dataset) {
     mapdb::MapOrigin origin;
     origin.dataset = dataset;
     origin.created_utc = utc_now();
-    origin.crowdslam_version = CROWDSLAM_VERSION;
+    origin.crowdslam_version = crowdslam::version();
     origin.end_state = closed_ ? "completed" : "running";
     slam.save_map(path, origin);
   });

@@ -1,5 +1,5 @@
 """`crowdslam map optimise` and scripts/map_vs_groundtruth.py on a synthetic RGB-D map (docs/MAPPING.md
-"Session 20"). They live with the pytest files because the checks edit map files with Python's sqlite3.
+"How to measure"). They live with the pytest files because the checks edit map files with Python's sqlite3.
 
 The synthetic sequence is rendered from known camera poses, so the map's observations must agree with its
 ground truth, and a global bundle adjustment must pull perturbed keyframes back to where the measurements

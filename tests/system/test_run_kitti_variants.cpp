@@ -85,17 +85,16 @@ void expect_tracked_through_the_turn(size_t stride, size_t expected_frames, size
 }  // namespace
 
 // Weak tracking asks for a keyframe and waits for the mapper, so the turn at 3.3 Hz is tracked through
-// with one map (measured 0.28-0.36 m in session 17, 0.32-0.33 m in session 19).
+// with one map (measured 0.32-0.33 m over every frame).
 TEST(RunKittiVariants, AThirdOfTheRateKeepsTrackThroughTheTurn) {
   CROWDSLAM_REQUIRE_SHARED("kitti07_head");
   expect_tracked_through_the_turn(3, 34u, 33u);  // 97 % of 34
 }
 
-// Every 4th frame (2.5 Hz: up to 12 degrees of turn between frames). Threaded runs lost the turn at frame 8
-// in session 17 (32-36 % tracked, a new map that never initialised) while `--sequential` tracked it all:
-// frames whose keyframe was due but skipped because the mapper was busy left the next frame, two views of
-// the turn further on, without map points. The unpaced run now waits for each due keyframe (measured
-// 0.32-0.39 m in session 18, 0.35-0.37 m in session 19).
+// Every 4th frame (2.5 Hz: up to 12 degrees of turn between frames). A threaded run that skipped a due
+// keyframe because the mapper was busy lost the turn at frame 8 (32-36 % tracked, a new map that never
+// initialised) while `--sequential` tracked it all: the next frame, two views of the turn further on, had
+// no map points. The unpaced run waits for each due keyframe (measured 0.35-0.37 m without the ground).
 TEST(RunKittiVariants, AQuarterOfTheRateKeepsTrackThroughTheTurn) {
   CROWDSLAM_REQUIRE_SHARED("kitti07_head");
   expect_tracked_through_the_turn(4, 25u, 25u);
@@ -176,7 +175,7 @@ TEST(RunKittiVariants, AnUnpacedRunWaitsForEveryDueKeyframe) {
 
 // The unpaced default waits for local mapping as sequential mode would (every due keyframe, and the frame
 // after a keyframe for its new points), so it makes about the keyframes of a `--sequential` run, with its
-// accuracy. Session 17's threaded runs made 38-41 against 82, at 0.346 m over keyframes against 0.276 m.
+// accuracy. Threaded runs that did not wait made 38-41 keyframes against 82, at 0.346 m over keyframes against 0.276 m.
 TEST(RunKittiVariants, AnUnpacedRunMakesTheKeyframesOfASequentialOne) {
   CROWDSLAM_REQUIRE_SHARED("kitti07_head");
   test::TempDir tmp;

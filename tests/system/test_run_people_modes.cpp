@@ -55,7 +55,7 @@ TEST(RunPeopleModes, LatestModePropagatesEveryFrameAndStillTracksTheCrowd) {
   const auto latest = run_with(dataset, tmp / "latest", "latest", "off");
   EXPECT_EQ(latest.tracked, 90u);
   ASSERT_TRUE(latest.ate_rmse_m.has_value());
-  // 0.0101 m with 38 keyframes since session 13 (0.0062 m when the keyframe test counted keyframe
+  // 0.0101 m with 38 keyframes (0.0062 m when the keyframe test counted keyframe
   // observations and this sequential run made a keyframe on all 90 frames); `every_frame` on the same
   // crowd: 0.017 m. Threaded, 9 runs: median 0.0052 m.
   EXPECT_LT(*latest.ate_rmse_m, 0.015);

@@ -35,7 +35,7 @@ TEST(FrameBuilder, DepthGivesVirtualRightCoordinate) {
   // Left half at 2 m, right half without depth.
   cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(0));
   depth(cv::Rect(0, 0, 320, 480)).setTo(10000);
-  tracking::RawFeatures raw;
+  feature::RawFeatures raw;
   builder.extract(gray, 800, raw);
   ASSERT_GT(raw.keys.size(), 600u);
   const auto f = builder.assemble(std::move(raw), depth);
@@ -62,7 +62,7 @@ TEST(FrameBuilder, DepthGivesVirtualRightCoordinate) {
 
 TEST(FrameBuilder, MonocularHasNoDepth) {
   tracking::FrameBuilder builder(camera(), {});
-  tracking::RawFeatures raw;
+  feature::RawFeatures raw;
   builder.extract(textured_image(640, 480), 500, raw);
   const auto f = builder.assemble(std::move(raw), cv::Mat());
   ASSERT_GT(f->size(), 300u);

@@ -49,7 +49,7 @@ class MonocularInit : public ::testing::Test {
   map::Frame make_frame(uint64_t id, const cv::Mat& colour) {
     cv::Mat gray;
     cv::cvtColor(colour, gray, cv::COLOR_BGR2GRAY);
-    tracking::RawFeatures raw;
+    feature::RawFeatures raw;
     builder_->extract(gray, 2000, raw);
     return map::Frame(id, static_cast<double>(id), camera_, builder_->levels(),
                       builder_->assemble(std::move(raw), {}));

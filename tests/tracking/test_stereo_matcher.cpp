@@ -222,7 +222,7 @@ TEST(StereoMatcher, RenderedStereoPairDepthMatchesTheRenderer) {
   cv::Mat left_gray, right_gray;
   cv::cvtColor(left.colour, left_gray, cv::COLOR_BGR2GRAY);
   cv::cvtColor(right.colour, right_gray, cv::COLOR_BGR2GRAY);
-  tracking::RawFeatures raw_left, raw_right;
+  feature::RawFeatures raw_left, raw_right;
   builder.extract(left_gray, 1000, raw_left);
   builder.extract_right(right_gray, 1000, raw_right);
   const auto f = builder.assemble_stereo(std::move(raw_left), raw_right);
@@ -266,14 +266,14 @@ TEST(StereoMatcher, FrameBuilderRejectsUnrectifiedCameraAndMismatchedSizes) {
   camera->bf = kBf;
   {
     tracking::FrameBuilder builder(camera, {});
-    tracking::RawFeatures l, r;
+    feature::RawFeatures l, r;
     builder.extract(textured_image(640, 480, 1), 300, l);
     builder.extract_right(textured_image(320, 240, 2), 300, r);
     EXPECT_THROW((void)builder.assemble_stereo(std::move(l), r), InputError);
   }
   camera->distortion.k1 = -0.2;
   tracking::FrameBuilder builder(camera, {});
-  tracking::RawFeatures l, r;
+  feature::RawFeatures l, r;
   builder.extract(textured_image(640, 480, 1), 300, l);
   builder.extract_right(textured_image(640, 480, 2), 300, r);
   EXPECT_THROW((void)builder.assemble_stereo(std::move(l), r), InputError);

@@ -11,13 +11,6 @@ namespace {
 
 constexpr std::size_t kMinMatches = 3;
 
-std::vector<double> stamps_of(const io::Trajectory& trajectory) {
-  std::vector<double> stamps;
-  stamps.reserve(trajectory.size());
-  for (const io::StampedPose& pose : trajectory) stamps.push_back(pose.timestamp_s);
-  return stamps;
-}
-
 std::string format_seconds(double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%g", value);

@@ -20,13 +20,6 @@ std::string format_number(double value) {
   return buffer;
 }
 
-std::vector<double> stamps_of(const io::Trajectory& trajectory) {
-  std::vector<double> stamps;
-  stamps.reserve(trajectory.size());
-  for (const io::StampedPose& pose : trajectory) stamps.push_back(pose.timestamp_s);
-  return stamps;
-}
-
 // The script's ominus(a, b) = inv(a) * b and scale(a, s) (translation times s).
 SE3 ominus(const SE3& a, const SE3& b) { return a.inverse() * b; }
 SE3 scale_translation(const SE3& a, double s) { return SE3(a.rotation(), s * a.translation()); }

@@ -4,12 +4,16 @@
 
 namespace crowdslam::eval {
 
-io::Trajectory unique_sorted_by_stamp(const io::Trajectory& trajectory) {
+std::vector<double> stamps_of(const io::Trajectory& trajectory) {
   std::vector<double> stamps;
   stamps.reserve(trajectory.size());
   for (const io::StampedPose& pose : trajectory) stamps.push_back(pose.timestamp_s);
+  return stamps;
+}
+
+io::Trajectory unique_sorted_by_stamp(const io::Trajectory& trajectory) {
   io::Trajectory result;
-  for (std::size_t index : io::dedupe_last_wins(stamps)) result.push_back(trajectory[index]);
+  for (std::size_t index : io::dedupe_last_wins(stamps_of(trajectory))) result.push_back(trajectory[index]);
   return result;
 }
 

@@ -7,4 +7,7 @@ namespace crowdslam::eval {
 
 io::Trajectory unique_sorted_by_stamp(const io::Trajectory& trajectory);
 
+// The trajectory's timestamps, in its order.
+std::vector<double> stamps_of(const io::Trajectory& trajectory);
+
 }  // namespace crowdslam::eval

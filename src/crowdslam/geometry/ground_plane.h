@@ -3,7 +3,7 @@
 // robot): the one length a monocular map sees in every keyframe.
 //
 // A monocular map has no scale of its own; local BA passes it from keyframe to keyframe, and where the
-// parallax stays small for long (a slow turn) it drifts by 15-20 % (docs/MAPPING.md, session 21). The
+// parallax stays small for long (a slow turn) it drifts by 15-20 % (docs/MAPPING.md, "Ground constraint"). The
 // camera's height above the road does not change, so the road under each keyframe, measured in that
 // keyframe's camera frame, shows the drift, and a global BA that holds it constant removes it
 // (loop::GlobalBundleAdjuster with ground constraints).
@@ -37,7 +37,7 @@ struct GroundPlaneOptions {
   double max_lateral_ratio = 1.5;      // ground points within this many heights of the camera, sideways
   double max_height_change = 0.3;      // relative, against the reference height
   // The sigma of a keyframe's height in BA, relative to the reference height: each of its n ground points
-  // gets keyframe_sigma * sqrt(n) (measured: 0.01, docs/MAPPING.md session 21).
+  // gets keyframe_sigma * sqrt(n) (measured: 0.01, docs/MAPPING.md "Ground constraint").
   double keyframe_sigma = 0.01;
   void check() const;                  // throws InputError
 };

@@ -44,8 +44,8 @@ OrbSettings read_orb(const SettingsReader& r) {
   return o;
 }
 
-RectificationSide read_side(const SettingsReader& r, const std::string& side) {
-  RectificationSide s;
+geometry::RectificationSide read_side(const SettingsReader& r, const std::string& side) {
+  geometry::RectificationSide s;
   s.height = r.required_integer(side + ".height");
   s.width = r.required_integer(side + ".width");
   s.K = r.required_matrix(side + ".K");
@@ -55,13 +55,13 @@ RectificationSide read_side(const SettingsReader& r, const std::string& side) {
   return s;
 }
 
-std::optional<StereoRectification> read_rectification(const SettingsReader& r) {
+std::optional<geometry::StereoRectification> read_rectification(const SettingsReader& r) {
   bool any = false;
   for (const char* side : {"LEFT", "RIGHT"})
     for (const char* key : {".height", ".width", ".K", ".D", ".R", ".P"})
       any = any || r.has(std::string(side) + key);
   if (!any) return std::nullopt;
-  return StereoRectification{read_side(r, "LEFT"), read_side(r, "RIGHT")};
+  return geometry::StereoRectification{read_side(r, "LEFT"), read_side(r, "RIGHT")};
 }
 
 void read_own_sections(const SettingsReader& r, Settings& s) {
@@ -120,13 +120,13 @@ bool same_matrix(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
 }
 
-bool same_side(const RectificationSide& a, const RectificationSide& b) {
+bool same_side(const geometry::RectificationSide& a, const geometry::RectificationSide& b) {
   return a.width == b.width && a.height == b.height && same_matrix(a.K, b.K) && same_matrix(a.D, b.D) &&
          same_matrix(a.R, b.R) && same_matrix(a.P, b.P);
 }
 
-bool same_rectification(const std::optional<StereoRectification>& a,
-                        const std::optional<StereoRectification>& b) {
+bool same_rectification(const std::optional<geometry::StereoRectification>& a,
+                        const std::optional<geometry::StereoRectification>& b) {
   if (!a || !b) return !a && !b;
   return same_side(a->left, b->left) && same_side(a->right, b->right);
 }
@@ -209,6 +209,20 @@ bool operator==(const Settings& a, const Settings& b) {
          a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&
          a.has_baseline == b.has_baseline && a.output.trajectory_format == b.output.trajectory_format &&
          same_rectification(a.rectification, b.rectification);
+}
+
+void apply_rectification(Settings& settings, const geometry::StereoRectification& rectification) {
+  const cv::Mat& p = rectification.left.P;
+  auto& c = settings.camera;
+  c.fx = p.at<double>(0, 0);
+  c.fy = p.at<double>(1, 1);
+  c.cx = p.at<double>(0, 2);
+  c.cy = p.at<double>(1, 2);
+  c.k1 = c.k2 = c.p1 = c.p2 = c.k3 = 0.0;
+  c.bf = -rectification.right.P.at<double>(0, 3);
+  c.width = rectification.left.width;
+  c.height = rectification.left.height;
+  settings.rectification = rectification;
 }
 
 }  // namespace crowdslam::io

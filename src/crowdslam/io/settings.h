@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdslam/geometry/stereo_rectification.h"
 #include "crowdslam/io/dataset.h"
 
 namespace crowdslam::io {
@@ -44,20 +45,6 @@ struct OrbSettings {
   int min_th_fast = 7;
 };
 
-struct RectificationSide {
-  int width = 0;
-  int height = 0;
-  cv::Mat K;  // 3x3 CV_64F
-  cv::Mat D;  // 1xN CV_64F (4, 5, 8, 12 or 14 coefficients)
-  cv::Mat R;  // 3x3 CV_64F
-  cv::Mat P;  // 3x4 CV_64F
-};
-
-struct StereoRectification {
-  RectificationSide left;
-  RectificationSide right;
-};
-
 struct DetectorSettings {
   std::string model_cfg;  // model name (body, coco, yolox, bytetrack), Darknet .cfg or .onnx (empty = body)
   std::string model_weights;  // Darknet .weights
@@ -75,7 +62,7 @@ struct DetectorSettings {
   // as the paper); see people::raw_boxes_near_leaders.
   double raw_box_max_area_ratio = 2.0;
   // "every_frame": detect on every frame, the frame waits for its boxes; "latest": the detector takes the
-  // newest frame when free, other frames get its boxes moved by the image flow (system/people_stage.h).
+  // newest frame when free, other frames get its boxes moved by the image flow (people/people_stage.h).
   std::string mode = "every_frame";
   // latest mode: a frame is offered to the detector only this many frames after the last one it took
   // (1 = whenever it is free); between detections the boxes move with the image flow.
@@ -164,7 +151,7 @@ struct Settings {
   double th_depth = 40.0;         // close/far threshold in multiples of the baseline (stereo, RGB-D)
   double depth_map_factor = 1.0;  // raw depth / factor = metres (RGB-D)
   OrbSettings orb;
-  std::optional<StereoRectification> rectification;
+  std::optional<geometry::StereoRectification> rectification;
   DetectorSettings detector;
   PeopleFilterSettings people_filter;
   GeometrySettings geometry;
@@ -200,5 +187,9 @@ Settings load_settings(const std::string& path, SensorKind sensor);
 // Camera.bf as has_depth_map_factor / has_baseline say) atomically; numbers with 17 significant digits,
 // so load_settings(path, sensor) == settings. Checks nothing.
 void write_settings(const std::string& path, const Settings& settings);
+
+// Sets settings.rectification and Camera.* (fx, fy, cx, cy from LEFT.P, bf = -RIGHT.P(0,3), distortion
+// zero, width and height of the rectified images).
+void apply_rectification(Settings& settings, const geometry::StereoRectification& rectification);
 
 }  // namespace crowdslam::io

@@ -104,7 +104,7 @@ void check_orb(const Checker& c, const OrbSettings& o) {
             "<= 254 (a FAST threshold on 8-bit intensities)", o.ini_th_fast);
 }
 
-void check_side(const Checker& c, const RectificationSide& s, const std::string& side) {
+void check_side(const Checker& c, const geometry::RectificationSide& s, const std::string& side) {
   c.require(s.width > 0 && s.width <= kMaxImageSide, side + ".width", "in 1..65535", s.width);
   c.require(s.height > 0 && s.height <= kMaxImageSide, side + ".height", "in 1..65535", s.height);
   auto shape = [&](const cv::Mat& m, int rows, int cols, const std::string& key) {
@@ -127,7 +127,7 @@ void check_side(const Checker& c, const RectificationSide& s, const std::string&
             s.P.at<double>(0, 0));
 }
 
-void check_rectification(const Checker& c, const StereoRectification& r, const CameraSettings& cam) {
+void check_rectification(const Checker& c, const geometry::StereoRectification& r, const CameraSettings& cam) {
   check_side(c, r.left, "LEFT");
   check_side(c, r.right, "RIGHT");
   const cv::Mat& p = r.left.P;

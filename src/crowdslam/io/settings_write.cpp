@@ -45,7 +45,7 @@ void write_matrix(std::ostream& out, const std::string& key, const cv::Mat& matr
   out << " ]\n";
 }
 
-void write_side(std::ostream& out, const std::string& side, const RectificationSide& s) {
+void write_side(std::ostream& out, const std::string& side, const geometry::RectificationSide& s) {
   out << side << ".height: " << s.height << "\n" << side << ".width: " << s.width << "\n";
   write_matrix(out, side + ".D", s.D);
   write_matrix(out, side + ".K", s.K);

@@ -14,8 +14,6 @@ using geometry::Vec6;
 
 namespace {
 
-constexpr double kMinAbsDepth = 1e-12;
-
 using ConstQuaternionMap = Eigen::Map<const Eigen::Quaterniond>;
 using ConstVec3Map = Eigen::Map<const Vec3>;
 

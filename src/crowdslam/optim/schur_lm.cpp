@@ -19,7 +19,6 @@ namespace {
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat63 = Eigen::Matrix<double, 6, 3>;
 
-constexpr double kMinAbsDepth = 1e-12;  // as the Ceres cost functions (ceres_pose.cpp)
 constexpr double kMinDiagonal = 1e-6;   // Ceres' min_lm_diagonal / max_lm_diagonal
 constexpr double kMaxDiagonal = 1e32;
 constexpr double kInitialMu = 1e-4;  // 1 / Ceres' initial_trust_region_radius

@@ -16,6 +16,10 @@ using Mat23 = Eigen::Matrix<double, 2, 3>;
 using Mat26 = Eigen::Matrix<double, 2, 6>;
 using Mat36 = Eigen::Matrix<double, 3, 6>;
 
+// Points nearer than this to the camera plane are not projected (every reprojection cost and the Schur
+// LM report them as invalid).
+inline constexpr double kMinAbsDepth = 1e-12;
+
 inline geometry::SE3 left_update(const geometry::Vec6& delta, const geometry::SE3& cam_from_world) {
   const geometry::Mat3 d_rotation = geometry::so3_exp(delta.tail<3>());
   const Eigen::Quaterniond dq(d_rotation);

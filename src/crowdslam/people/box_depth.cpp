@@ -126,7 +126,7 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
       box.x < near || box.x + box.width > static_cast<float>(depth_image_raw.cols) - near;
   if (!decided && at_side_edge) {
     // The box reaches the image's left or right edge and fewer than two sides outside it have depth (a
-    // false positive filling the image's width, session 13): strips just inside its left and right edges
+    // false positive filling the image's width): strips just inside its left and right edges
     // stand in for them. Beside a standing person those strips are mostly background (the box spans the
     // arms and legs, the torso sits in the middle); on a wall they are wall. Holes in the depth image
     // around a box inside the image still leave it undecided.

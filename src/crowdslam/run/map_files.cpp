@@ -8,6 +8,7 @@
 
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
+#include "crowdslam/util/version.h"
 
 namespace crowdslam::run {
 
@@ -97,7 +98,7 @@ void save_map_if_requested(const RunOptions& options, const system::System& slam
   mapdb::MapOrigin origin;
   origin.dataset = options.dataset;
   origin.created_utc = utc_now();
-  origin.crowdslam_version = CROWDSLAM_VERSION;
+  origin.crowdslam_version = crowdslam::version();
   origin.end_state = end_state;
   const auto start = std::chrono::steady_clock::now();
   slam.save_map(options.save_map, origin);

@@ -13,6 +13,7 @@
 #include "crowdslam/eval/rpe.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
+#include "crowdslam/util/version.h"
 
 namespace crowdslam::run {
 
@@ -228,7 +229,8 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
 nlohmann::json running_document(const RunOptions& options, const std::string& settings_path,
                                 io::SensorKind sensor) {
   return {
-      {"crowdslam_version", CROWDSLAM_VERSION},   {"end_state", "running"},
+      {"crowdslam_version", crowdslam::version()}, {"git_commit", crowdslam::git_commit()},
+      {"end_state", "running"},
       {"pid", static_cast<long>(::getpid())},     {"started", utc_now()},
       {"dataset", dataset_path(options.dataset)}, {"settings", settings_path},
       {"sensor", io::to_string(sensor)},          {"mode", options.sequential ? "sequential" : "threaded"}};
@@ -272,10 +274,10 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
     waited_for_mapping_ms += r.waited_for_mapping_ms;
     frames_waited += r.waited_for_mapping_ms > 0 ? 1 : 0;
   }
-  const system::PeopleStage* people = slam.people_stage();
+  const people::PeopleStage* people = slam.people_stage();
   doc["people_filter"] =
       people != nullptr ? nlohmann::json{{"detector", slam.detector_name()},
-                                         {"detector_mode", system::to_string(people->mode())},
+                                         {"detector_mode", people::to_string(people->mode())},
                                          {"latest_interval", s.detector.latest_interval},
                                          {"box_tracker", people->tracker_enabled()},
                                          {"detections", people->stats().detections},

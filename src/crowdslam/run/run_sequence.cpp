@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "crowdslam/io/euroc_dataset.h"
+#include "crowdslam/io/euroc_rectification.h"
 #include "crowdslam/io/settings.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/journal/output_dir.h"
@@ -41,8 +42,8 @@ void prepare_stereo_settings(const io::FrameSource& source, io::Settings& settin
     const auto right_from_left = euroc->right_from_left();
     assert(right && right_from_left);  // a stereo EuRoC dataset has cam1
     const std::string where = source.path() + " (cam0/cam1 sensor.yaml)";
-    system::apply_rectification(settings, system::rectification_from_euroc(euroc->left_calibration(), *right,
-                                                                           *right_from_left, where));
+    io::apply_rectification(settings,
+                            io::rectification_from_euroc(euroc->left_calibration(), *right, *right_from_left, where));
     spdlog::info("stereo rectification computed from {}: fx {:.3f}, bf {:.4f}", where, settings.camera.fx,
                  settings.camera.bf);
     return;

@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "crowdslam/geometry/angles.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::synth {
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+using geometry::kPi;
 
 // 0 -> 1 -> 0 over one period, smooth at the turning points (no infinite acceleration).
 double back_and_forth(double t, double period_s) {

@@ -4,13 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include "crowdslam/geometry/angles.h"
 #include "crowdslam/synth/rng.h"
 #include "crowdslam/synth/options.h"
 
 namespace crowdslam::synth {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using geometry::kPi;
 constexpr double kBodyRadiusM = 0.28;      // circle around the body footprint
 constexpr double kWallMarginM = 0.1;
 constexpr double kPersonSpacingM = 0.7;   // between body centres

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "crowdslam/geometry/angles.h"
 #include "crowdslam/synth/rng.h"
 
 namespace crowdslam::synth {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using geometry::kPi;
 constexpr double kTwoPi = 2.0 * kPi;
 
 struct PoseParams {

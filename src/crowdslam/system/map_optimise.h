@@ -6,7 +6,7 @@
 //
 // Use it to refine a map before reusing it (--load-map), or to ask what the map's measurements alone say:
 // the optimum of the reprojection error over the whole map, independent of the order and the windows in
-// which local mapping optimised it (docs/MAPPING.md "Session 20" uses it that way). With --ground, the
+// which local mapping optimised it (docs/MAPPING.md "How to measure" uses it that way). With --ground, the
 // global BA a monocular run on a car ends with (Ground.enabled), applied to a saved map.
 #include <cstddef>
 #include <filesystem>

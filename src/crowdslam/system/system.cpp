@@ -16,7 +16,7 @@ namespace crowdslam::system {
 
 namespace {
 // Iterations of the global BA with the ground that ends a completed run (20: converged on kitti07_head
-// and its variants, docs/MAPPING.md session 21).
+// and its variants, docs/MAPPING.md "Ground constraint").
 constexpr int kFinalGroundBaIterations = 20;
 
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
@@ -54,7 +54,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   // Frames get their bag of words from tracking, only when needed (tracking/frame_bow.h).
   frame_builder_ = std::make_unique<tracking::FrameBuilder>(camera_, builder_options);
   if (options.sensor == io::SensorKind::kStereo && settings.rectification) {
-    rectifier_ = std::make_unique<StereoRectifier>(*settings.rectification, settings.path);
+    rectifier_ = std::make_unique<geometry::StereoRectifier>(*settings.rectification, settings.path);
   }
 
   if (options.sensor == io::SensorKind::kMonocular && settings.ground.enabled) {
@@ -127,11 +127,11 @@ System::System(const io::Settings& settings, const SystemOptions& options)
 
   next_feature_budget_ = frame_builder_->default_num_features();
   if (options.people_filter && settings.people_filter.enabled) {
-    PeopleStageOptions people_options;
+    people::PeopleStageOptions people_options;
     people_options.sensor = options.sensor;
     people_options.detections_file = options.detections_file;
     people_options.detector_model = options.detector_model;
-    people_ = std::make_unique<PeopleStage>(settings, people_options);
+    people_ = std::make_unique<people::PeopleStage>(settings, people_options);
   }
   if (!options.sequential) mapper_->start();
 }
@@ -232,7 +232,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   // for the thread, so they outlive it even on an exception.
   cv::Mat left_colour = images.colour;
   cv::Mat right_gray;
-  tracking::RawFeatures raw_right;
+  feature::RawFeatures raw_right;
   std::future<void> right_done;
   if (stereo) {
     right_gray = feature::to_gray(images.right);
@@ -249,7 +249,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   // The detector works on its own thread while ORB features are extracted here.
   const cv::Mat gray = feature::to_gray(left_colour);
   if (people_) people_->begin_frame(frame_index, left_colour, gray);
-  tracking::RawFeatures raw;
+  feature::RawFeatures raw;
   frame_builder_->extract(gray, report.feature_budget, raw);
   report.keypoints_before_filter = static_cast<int>(raw.keys.size());
   if (stereo) {
@@ -262,14 +262,14 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     report.stereo_match_ms = elapsed_ms(match_start);
   }
   // The keypoints before the filter: tracking may take back those in boxes (Tracker::track).
-  std::optional<tracking::RawFeatures> unfiltered;
+  std::optional<feature::RawFeatures> unfiltered;
   std::vector<long> filtered_index;
   std::vector<int> box_of;
   if (people_) {
     if (box_keypoints_) {
-      unfiltered.emplace(tracking::RawFeatures{raw.keys, raw.descriptors.clone(), raw.right_u, raw.depth_m});
+      unfiltered.emplace(feature::RawFeatures{raw.keys, raw.descriptors.clone(), raw.right_u, raw.depth_m});
     }
-    PeopleFrame p = people_->filter(frame_index, images, raw, options_.record_keypoints);
+    people::PeopleFrame p = people_->filter(frame_index, images, raw, options_.record_keypoints);
     report.person_boxes = p.person_boxes;
     report.people_area = p.people_area;
     report.keypoints_before_filter = p.keypoints_before_filter;

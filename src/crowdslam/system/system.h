@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "crowdslam/bow/vocabulary.h"
+#include "crowdslam/geometry/stereo_rectification.h"
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/io/settings.h"
 #include "crowdslam/io/trajectory.h"
@@ -14,9 +15,8 @@
 #include "crowdslam/loop/loop_closer.h"
 #include "crowdslam/mapdb/map_database.h"
 #include "crowdslam/mapping/local_mapper.h"
-#include "crowdslam/system/people_stage.h"
+#include "crowdslam/people/people_stage.h"
 #include "crowdslam/system/run_observer.h"
-#include "crowdslam/system/stereo_rectifier.h"
 #include "crowdslam/tracking/frame_builder.h"
 #include "crowdslam/tracking/tracker.h"
 
@@ -177,7 +177,7 @@ class System {
   [[nodiscard]] bool people_filter_enabled() const { return people_ != nullptr; }
   [[nodiscard]] std::string detector_name() const;
   // The people filter's stage (null when the filter is off).
-  [[nodiscard]] const PeopleStage* people_stage() const { return people_.get(); }
+  [[nodiscard]] const people::PeopleStage* people_stage() const { return people_.get(); }
   // Empty when running without a vocabulary.
   [[nodiscard]] const std::optional<VocabularyInfo>& vocabulary_info() const { return vocabulary_info_; }
 
@@ -209,7 +209,7 @@ class System {
   std::unique_ptr<loop::KeyframeDatabase> keyframe_database_;  // with a vocabulary only
   std::unique_ptr<loop::LoopCloser> loop_closer_;              // with a vocabulary and loop closing on
   std::unique_ptr<tracking::FrameBuilder> frame_builder_;
-  std::unique_ptr<StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
+  std::unique_ptr<geometry::StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   bool box_keypoints_ =
@@ -218,7 +218,7 @@ class System {
   std::vector<MapSegment> segments_;  // the last one is the current map
   io::Trajectory past_keyframes_;     // keyframes of maps that were reset
   std::vector<RunObserver*> observers_;
-  std::unique_ptr<PeopleStage> people_;  // null when the people filter is off
+  std::unique_ptr<people::PeopleStage> people_;  // null when the people filter is off
   int next_feature_budget_ = 0;
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;

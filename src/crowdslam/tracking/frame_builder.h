@@ -16,6 +16,7 @@
 
 #include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/feature/orb_extractor.h"
+#include "crowdslam/feature/raw_features.h"
 #include "crowdslam/geometry/camera.h"
 #include "crowdslam/map/frame_features.h"
 #include "crowdslam/map/scale_levels.h"
@@ -23,14 +24,7 @@
 
 namespace crowdslam::tracking {
 
-struct RawFeatures {
-  std::vector<cv::KeyPoint> keys;
-  cv::Mat descriptors;
-  // Stereo, after FrameBuilder::match_stereo(): per keypoint the right-image u and the depth (-1 = none).
-  // Whoever drops keypoints (the people filter) drops their entries too.
-  std::vector<float> right_u;
-  std::vector<float> depth_m;
-};
+using feature::RawFeatures;
 
 class FrameBuilder {
  public:

@@ -46,11 +46,11 @@ struct TrackerOptions {
   // Monocular: a frame that tracks fewer map points than this is a few bad frames from being lost, so it
   // asks for a keyframe whatever the reference ratio says, and waits for a busy mapper (backpressure)
   // rather than going on without new points, and the next frame waits until the mapper has mapped that
-  // keyframe (docs/MAPPING.md, session 17). 0 = off.
+  // keyframe (docs/MAPPING.md, "Keyframe policy"). 0 = off.
   int monocular_weak_tracking_inliers = 100;
   // Monocular, with max_wait_for_mapping_ms > 0: an unpaced replay waits for local mapping as sequential
   // mode would, so that it makes sequential mode's keyframes with its accuracy and throughput follows the
-  // mapper's speed (issue 11, docs/MAPPING.md session 18): a keyframe that is due (the reference ratio)
+  // mapper's speed (docs/MAPPING.md, "Backpressure"): a keyframe that is due (the reference ratio)
   // while the mapper is busy is waited for, not skipped, and the frame after a keyframe waits until the
   // mapper has made that keyframe's new points (its local BA then runs while the frame is tracked). Off
   // (a paced replay, a live camera): only urgent keyframes are waited for (overdue, weak tracking, under

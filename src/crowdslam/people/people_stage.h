@@ -1,14 +1,14 @@
 #pragma once
 // The people filter's part of building a frame (Crowd-SLAM's detector thread, keypoint filter and
-// feature-number update), taken out of System so the system file stays about wiring.
+// feature-number update): System calls begin_frame() before ORB extraction and filter() after it.
 //
 // Two detector modes (Detector.mode):
 //  - every_frame: the detector runs on every frame, beside ORB extraction, and the frame waits for its
 //    boxes (the paper's design: a slow detector slows SLAM down to its own rate);
 //  - latest: the detector takes the newest frame whenever it is free and tracking never waits; each frame
-//    uses the newest finished detection moved to it with the image motion (people/box_flow.h), marked as
+//    uses the newest finished detection moved to it with the image motion (box_flow.h), marked as
 //    propagated when the detection was made on an earlier frame.
-// With Detector.tracker, detections update short-term tracks (people/box_tracker.h) and the filter uses
+// With Detector.tracker, detections update short-term tracks (box_tracker.h) and the filter uses
 // the confirmed tracks: a box survives a missed detection or two, a one-detection box is not used unless
 // it is confident.
 #include <cstddef>
@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdslam/feature/raw_features.h"
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/io/settings.h"
 #include "crowdslam/people/box_flow.h"
@@ -25,9 +26,8 @@
 #include "crowdslam/people/detection_worker.h"
 #include "crowdslam/people/feature_budget.h"
 #include "crowdslam/people/keypoint_filter.h"
-#include "crowdslam/tracking/frame_builder.h"
 
-namespace crowdslam::system {
+namespace crowdslam::people {
 
 enum class DetectorMode { kEveryFrame, kLatest };
 DetectorMode parse_detector_mode(const std::string& name, const std::string& key);
@@ -50,7 +50,7 @@ struct PeopleFrame {
   int flat_boxes = 0;             // RGB-D: boxes with nothing standing out of their surroundings, ignored
   int64_t detection_frame = -1;   // frame the boxes were detected on (-1: no detection yet)
   bool boxes_propagated = false;  // boxes moved here from an earlier frame by the image flow
-  std::vector<people::PersonBox> boxes;         // used for filtering
+  std::vector<PersonBox> boxes;         // used for filtering
   std::vector<cv::KeyPoint> removed_keypoints;  // only when recording keypoints
   // When the filter removed keypoints: per keypoint before the filter, its index after it (-1 = removed)
   // and the box that removed it (index into `boxes`, -1 = kept).
@@ -81,7 +81,7 @@ class PeopleStage {
   void begin_frame(std::size_t index, const cv::Mat& colour, const cv::Mat& gray);
   // After extraction (and stereo matching): the frame's boxes (every_frame waits for them), the keypoints
   // on people removed from `raw`, and the next frame's feature budget.
-  PeopleFrame filter(std::size_t index, const io::FrameImages& images, tracking::RawFeatures& raw,
+  PeopleFrame filter(std::size_t index, const io::FrameImages& images, feature::RawFeatures& raw,
                      bool record_keypoints);
 
   [[nodiscard]] int next_feature_budget() const { return next_feature_budget_; }
@@ -93,25 +93,25 @@ class PeopleStage {
 
  private:
   // A detection result in the current frame's coordinates: moved from its own frame's grey image.
-  void take_detection(people::WorkerResult result, const people::FlowImage& image);
+  void take_detection(WorkerResult result, const FlowImage& image);
   // Boxes the filter uses now, and the ones (NMS level) that say how much of the image people cover.
-  void current_boxes(std::vector<people::PersonBox>& filter_boxes,
-                     std::vector<people::PersonBox>& area_boxes) const;
+  void current_boxes(std::vector<PersonBox>& filter_boxes,
+                     std::vector<PersonBox>& area_boxes) const;
   // The raw boxes used as masks (Detector.raw_box_max_area_ratio); counts the ones left out.
-  std::vector<people::PersonBox> masking_raw_boxes(const people::Detections& detections);
-  void move_to(const people::FlowImage& image);
-  void flow(const people::FlowImage& from, const people::FlowImage& to, std::vector<people::FlowBox>& boxes,
+  std::vector<PersonBox> masking_raw_boxes(const Detections& detections);
+  void move_to(const FlowImage& image);
+  void flow(const FlowImage& from, const FlowImage& to, std::vector<FlowBox>& boxes,
             std::vector<bool>* nms, std::vector<int>* leader);
 
   io::SensorKind sensor_;
   double depth_map_factor_ = 1.0;
-  std::unique_ptr<people::DetectionWorker> worker_;
+  std::unique_ptr<DetectionWorker> worker_;
   DetectorMode mode_ = DetectorMode::kEveryFrame;
-  people::KeypointFilterOptions filter_options_;
-  people::FeatureBudgetOptions budget_options_;
-  people::AreaMode area_mode_ = people::AreaMode::kSum;
-  people::BoxFlowOptions flow_options_;
-  std::optional<people::BoxTracker> tracker_;
+  KeypointFilterOptions filter_options_;
+  FeatureBudgetOptions budget_options_;
+  AreaMode area_mode_ = AreaMode::kSum;
+  BoxFlowOptions flow_options_;
+  std::optional<BoxTracker> tracker_;
   bool filter_before_nms_ = true;
   double raw_box_max_area_ratio_ = 0.0;
   bool right_image_boxes_ = false;
@@ -119,11 +119,11 @@ class PeopleStage {
   int next_feature_budget_ = 0;
   // Without the tracker, the newest detection's boxes (raw ones, with `nms_` marking those NMS kept) in
   // the frame `current_` shows (latest mode).
-  std::vector<people::FlowBox> boxes_;
+  std::vector<FlowBox> boxes_;
   std::vector<bool> nms_;
   std::vector<int> leader_;  // per box: the NMS box a raw box moves with (-1: moved by its own flow)
-  people::FlowImage current_;
-  people::FlowImage offered_;  // the frame the detector is working on (latest mode)
+  FlowImage current_;
+  FlowImage offered_;  // the frame the detector is working on (latest mode)
   std::size_t offered_index_ = 0;
   bool offered_any_ = false;
   std::size_t latest_interval_ = 1;  // Detector.latest_interval
@@ -133,4 +133,4 @@ class PeopleStage {
   PeopleStageStats stats_;
 };
 
-}  // namespace crowdslam::system
+}  // namespace crowdslam::people

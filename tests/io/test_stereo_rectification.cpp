@@ -7,7 +7,8 @@
 
 #include "crowdslam/io/euroc_dataset.h"
 #include "crowdslam/io/settings.h"
-#include "crowdslam/system/stereo_rectifier.h"
+#include "crowdslam/geometry/stereo_rectification.h"
+#include "crowdslam/io/euroc_rectification.h"
 #include "crowdslam/util/error.h"
 #include "test_support.h"
 
@@ -35,7 +36,7 @@ cv::Point2d project_raw(const io::EurocCameraCalibration& c, const Eigen::Vector
 }
 
 // Rectified pixel of a raw pixel (what the remap tables invert).
-cv::Point2d rectify_point(const io::RectificationSide& s, const cv::Point2d& raw) {
+cv::Point2d rectify_point(const geometry::RectificationSide& s, const cv::Point2d& raw) {
   std::vector<cv::Point2d> out;
   cv::undistortPoints(std::vector<cv::Point2d>{raw}, out, s.K, s.D, s.R, s.P);
   return out[0];
@@ -51,10 +52,10 @@ TEST(StereoRectifier, RectifiedPairHasEqualRowsAndDisparityBfOverDepth) {
       (Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(-0.005, Eigen::Vector3d::UnitX()))
           .toRotationMatrix();
   right_from_left.topRightCorner<3, 1>() = Eigen::Vector3d(-0.11, 0.001, 0.0005);
-  const io::StereoRectification r = system::rectification_from_euroc(left, right, right_from_left, "test");
+  const geometry::StereoRectification r = io::rectification_from_euroc(left, right, right_from_left, "test");
 
   io::Settings settings;
-  system::apply_rectification(settings, r);
+  io::apply_rectification(settings, r);
   const double baseline = right_from_left.topRightCorner<3, 1>().norm();
   EXPECT_NEAR(settings.camera.bf, settings.camera.fx * baseline, 1e-9 * settings.camera.bf);
   EXPECT_EQ(settings.camera.k1, 0.0);
@@ -85,7 +86,7 @@ TEST(StereoRectifier, EurocCalibrationGivesTheShippedSettings) {
   CROWDSLAM_REQUIRE_SHARED("euroc_v101_micro");
   const auto dataset = io::open_euroc_dataset(test::shared_data("euroc_v101_micro").string());
   ASSERT_TRUE(dataset->right_calibration().has_value());
-  const auto computed = system::rectification_from_euroc(dataset->left_calibration(), *dataset->right_calibration(),
+  const auto computed = io::rectification_from_euroc(dataset->left_calibration(), *dataset->right_calibration(),
                                                          *dataset->right_from_left(), "euroc");
   const io::Settings shipped =
       io::load_settings((test::source_dir() / "config" / "EuRoC.yaml").string(), io::SensorKind::kStereo);
@@ -97,7 +98,7 @@ TEST(StereoRectifier, EurocCalibrationGivesTheShippedSettings) {
 }
 
 TEST(StereoRectifier, IdentityRectificationLeavesTheImageAndChecksItsSize) {
-  io::RectificationSide side;
+  geometry::RectificationSide side;
   side.width = 64;
   side.height = 48;
   side.K = (cv::Mat_<double>(3, 3) << 50, 0, 32, 0, 50, 24, 0, 0, 1);
@@ -105,7 +106,7 @@ TEST(StereoRectifier, IdentityRectificationLeavesTheImageAndChecksItsSize) {
   side.R = cv::Mat::eye(3, 3, CV_64F);
   side.P = cv::Mat::zeros(3, 4, CV_64F);
   side.K.copyTo(side.P(cv::Rect(0, 0, 3, 3)));
-  const system::StereoRectifier rectifier({side, side}, "settings.yaml");
+  const geometry::StereoRectifier rectifier({side, side}, "settings.yaml");
   cv::Mat image(48, 64, CV_8UC1);
   cv::randu(image, 0, 256);
   cv::Mat out;
@@ -123,16 +124,16 @@ TEST(StereoRectifier, UnsupportedCalibrationIsAnError) {
   Eigen::Matrix4d right_from_left = Eigen::Matrix4d::Identity();
   right_from_left(0, 3) = -0.1;
   right.distortion_model = "equidistant";
-  EXPECT_NE(test::error_of([&] { system::rectification_from_euroc(left, right, right_from_left, "x"); })
+  EXPECT_NE(test::error_of([&] { io::rectification_from_euroc(left, right, right_from_left, "x"); })
                 .find("equidistant"),
             std::string::npos);
   right = left;
   right_from_left(0, 3) = 0.0;
-  EXPECT_NE(test::error_of([&] { system::rectification_from_euroc(left, right, right_from_left, "x"); })
+  EXPECT_NE(test::error_of([&] { io::rectification_from_euroc(left, right, right_from_left, "x"); })
                 .find("baseline"),
             std::string::npos);
   right_from_left(0, 3) = 0.1;  // right camera on the left
-  EXPECT_NE(test::error_of([&] { system::rectification_from_euroc(left, right, right_from_left, "x"); })
+  EXPECT_NE(test::error_of([&] { io::rectification_from_euroc(left, right, right_from_left, "x"); })
                 .find("right of cam0"),
             std::string::npos);
 }

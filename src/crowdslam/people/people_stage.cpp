@@ -1,4 +1,4 @@
-#include "crowdslam/system/people_stage.h"
+#include "crowdslam/people/people_stage.h"
 
 #include <spdlog/spdlog.h>
 
@@ -13,14 +13,14 @@
 #include "crowdslam/people/mot_file_detector.h"
 #include "crowdslam/util/error.h"
 
-namespace crowdslam::system {
+namespace crowdslam::people {
 namespace {
 constexpr double kFlatTestMinArea = 0.1;  // fraction of the image (see PeopleStage::filter)
 
 constexpr double kSparseDepthFactor = 1000.0;  // millimetres in the stereo sparse depth image
 
 // CV_16UC1 image (depth * factor, 0 = none) with each keypoint's stereo depth written into a square
-// block. people::estimate_person_depth samples a box every sqrt(area / 2000) pixels; blocks that wide are
+// block. estimate_person_depth samples a box every sqrt(area / 2000) pixels; blocks that wide are
 // sampled at least once, so every keypoint in a box's centre counts.
 cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vector<float>& depth_m,
                            cv::Size size, double factor) {
@@ -37,13 +37,13 @@ cv::Mat sparse_depth_image(const std::vector<cv::KeyPoint>& keys, const std::vec
   return image;
 }
 
-std::unique_ptr<people::PersonDetector> make_detector(const io::Settings& settings,
+std::unique_ptr<PersonDetector> make_detector(const io::Settings& settings,
                                                       const PeopleStageOptions& options) {
-  people::DetectorSetup setup = people::detector_setup(settings.detector, options.detector_model);
+  DetectorSetup setup = detector_setup(settings.detector, options.detector_model);
   if (!options.detections_file.empty()) {
-    return std::make_unique<people::MotFileDetector>(options.detections_file, setup.options);
+    return std::make_unique<MotFileDetector>(options.detections_file, setup.options);
   }
-  return std::make_unique<people::DnnDetector>(setup.model, setup.options);
+  return std::make_unique<DnnDetector>(setup.model, setup.options);
 }
 
 }  // namespace
@@ -59,18 +59,18 @@ const char* to_string(DetectorMode mode) { return mode == DetectorMode::kLatest 
 PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions& options)
     : sensor_(options.sensor),
       depth_map_factor_(settings.depth_map_factor > 0 ? settings.depth_map_factor : 1.0),
-      worker_(std::make_unique<people::DetectionWorker>(make_detector(settings, options))) {
+      worker_(std::make_unique<DetectionWorker>(make_detector(settings, options))) {
   mode_ = parse_detector_mode(settings.detector.mode, "Detector.mode");
   latest_interval_ = static_cast<std::size_t>(std::max(1, settings.detector.latest_interval));
   if (settings.detector.tracker) {
-    people::BoxTrackerOptions t;
+    BoxTrackerOptions t;
     t.iou = settings.detector.track_iou;
     t.min_hits = settings.detector.track_min_hits;
     t.max_misses = settings.detector.track_max_misses;
     t.confirm_confidence = settings.detector.track_confirm_confidence;
     tracker_.emplace(t);
   }
-  filter_options_.mode = people::parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
+  filter_options_.mode = parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
   filter_options_.margin_px = settings.people_filter.margin_px;
   filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
   filter_options_.check();
@@ -82,7 +82,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   budget_options_.enabled = settings.feature_budget.enabled;
   budget_options_.thresholds = settings.feature_budget.thresholds;
   budget_options_.factors = settings.feature_budget.factors;
-  area_mode_ = settings.feature_budget.area == "union" ? people::AreaMode::kUnion : people::AreaMode::kSum;
+  area_mode_ = settings.feature_budget.area == "union" ? AreaMode::kUnion : AreaMode::kSum;
   spdlog::info("people detector {}: mode {}, tracker {}", worker_->detector().name(), to_string(mode_),
                tracker_ ? "on" : "off");
 }
@@ -91,10 +91,10 @@ namespace {
 // Seeds new corners in the boxes tracked by their own flow (no leader; all boxes when `leader` is null):
 // every such box, or with `only_thin` those with few corners left (lost to occlusion and the
 // forward-backward check).
-void seed_corners(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, const std::vector<int>* leader,
-                  const people::BoxFlowOptions& options, bool only_thin) {
+void seed_corners(const cv::Mat& gray, std::vector<FlowBox>& boxes, const std::vector<int>* leader,
+                  const BoxFlowOptions& options, bool only_thin) {
   std::vector<size_t> index;
-  std::vector<people::FlowBox> seeded;
+  std::vector<FlowBox> seeded;
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (leader != nullptr && (*leader)[i] >= 0) continue;
     if (only_thin && static_cast<int>(boxes[i].points.size()) >= 2 * options.min_points) continue;
@@ -102,14 +102,14 @@ void seed_corners(const cv::Mat& gray, std::vector<people::FlowBox>& boxes, cons
     seeded.push_back(boxes[i]);
   }
   if (seeded.empty()) return;
-  people::seed_points(gray, seeded, options);
+  seed_points(gray, seeded, options);
   for (size_t k = 0; k < index.size(); ++k) boxes[index[k]].points = std::move(seeded[k].points);
 }
 
 // For raw boxes: the NMS box each one follows (the kept box it overlaps most), -1 for the kept boxes
 // themselves and for a raw box that overlaps none.
-std::vector<int> leaders_of(const std::vector<people::FlowBox>& boxes, const std::vector<bool>& nms) {
-  std::vector<people::PersonBox> kept;
+std::vector<int> leaders_of(const std::vector<FlowBox>& boxes, const std::vector<bool>& nms) {
+  std::vector<PersonBox> kept;
   std::vector<int> kept_index;
   for (size_t k = 0; k < boxes.size(); ++k) {
     if (!nms[k]) continue;
@@ -119,7 +119,7 @@ std::vector<int> leaders_of(const std::vector<people::FlowBox>& boxes, const std
   std::vector<int> leader(boxes.size(), -1);
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (nms[i]) continue;
-    const int k = people::most_overlapping(boxes[i].box.box, kept);
+    const int k = most_overlapping(boxes[i].box.box, kept);
     if (k >= 0) leader[i] = kept_index[static_cast<size_t>(k)];
   }
   return leader;
@@ -129,11 +129,11 @@ std::vector<int> leaders_of(const std::vector<people::FlowBox>& boxes, const std
 // Moves `boxes` from `from` to `to`: boxes without a leader by the flow of their corners, the others
 // (raw boxes) by their leader's motion. `nms` and `leader` (one entry per box, may be null) follow their
 // boxes; a box that leaves the image is removed.
-void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& to,
-                       std::vector<people::FlowBox>& boxes, std::vector<bool>* nms,
+void PeopleStage::flow(const FlowImage& from, const FlowImage& to,
+                       std::vector<FlowBox>& boxes, std::vector<bool>* nms,
                        std::vector<int>* leader) {
   const auto has_leader = [&](size_t i) { return leader != nullptr && (*leader)[i] >= 0; };
-  std::vector<people::FlowBox> tracked;
+  std::vector<FlowBox> tracked;
   std::vector<cv::Point2f> centre(boxes.size());
   for (size_t i = 0; i < boxes.size(); ++i) {
     const cv::Rect2f& r = boxes[i].box.box;
@@ -142,15 +142,15 @@ void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& t
     tracked.push_back(boxes[i]);
     tracked.back().track_id = static_cast<int>(i);  // the original index, restored below
   }
-  std::vector<people::BoxMotion> tracked_motion;
-  const people::FlowStats s = people::move_boxes(from, to, tracked, flow_options_, &tracked_motion);
+  std::vector<BoxMotion> tracked_motion;
+  const FlowStats s = move_boxes(from, to, tracked, flow_options_, &tracked_motion);
   stats_.boxes_moved += s.boxes_moved;
   stats_.boxes_kept_in_place += s.boxes_kept;
-  std::vector<people::BoxMotion> motion(boxes.size());
+  std::vector<BoxMotion> motion(boxes.size());
   for (size_t i = 0, k = 0; i < boxes.size(); ++i) {
     if (!has_leader(i)) motion[i] = tracked_motion[k++];
   }
-  std::vector<std::optional<people::FlowBox>> moved(boxes.size());
+  std::vector<std::optional<FlowBox>> moved(boxes.size());
   for (auto& b : tracked) {
     const auto original = static_cast<size_t>(b.track_id);
     b.track_id = boxes[original].track_id;
@@ -160,14 +160,14 @@ void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& t
     if (!has_leader(i)) continue;
     const auto l = static_cast<size_t>((*leader)[i]);
     const cv::Rect2f r =
-        people::follow_motion(boxes[i].box.box, centre[l], motion[l], to.gray.cols, to.gray.rows);
+        follow_motion(boxes[i].box.box, centre[l], motion[l], to.gray.cols, to.gray.rows);
     if (!(r.width > 0) || !(r.height > 0)) continue;
     moved[i] = boxes[i];
     moved[i]->box.box = r;
     if (motion[l].moved) ++stats_.boxes_moved;
   }
   std::vector<int> new_index(boxes.size(), -1);
-  std::vector<people::FlowBox> out;
+  std::vector<FlowBox> out;
   for (size_t i = 0; i < boxes.size(); ++i) {
     if (!moved[i]) continue;
     new_index[i] = static_cast<int>(out.size());
@@ -186,11 +186,11 @@ void PeopleStage::flow(const people::FlowImage& from, const people::FlowImage& t
   if (leader != nullptr) *leader = std::move(leaders);
 }
 
-void PeopleStage::move_to(const people::FlowImage& image) {
+void PeopleStage::move_to(const FlowImage& image) {
   if (!current_.empty() && current_.gray.size() == image.gray.size() &&
       current_.gray.data != image.gray.data) {
     if (tracker_) {
-      std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
+      std::vector<FlowBox> boxes = tracker_->flow_boxes();
       if (!boxes.empty()) {
         flow(current_, image, boxes, nullptr, nullptr);
         seed_corners(image.gray, boxes, nullptr, flow_options_, true);
@@ -204,20 +204,20 @@ void PeopleStage::move_to(const people::FlowImage& image) {
   current_ = image;
 }
 
-void PeopleStage::take_detection(people::WorkerResult result, const people::FlowImage& image) {
+void PeopleStage::take_detection(WorkerResult result, const FlowImage& image) {
   ++stats_.detections;
   fresh_ = true;
   detection_frame_ = static_cast<int64_t>(result.frame_index);
   detection_ms_ = result.detections.time_ms;
   const bool use_raw = filter_before_nms_ && !tracker_;
-  std::vector<people::FlowBox> detected =
-      people::to_flow_boxes(use_raw ? masking_raw_boxes(result.detections) : result.detections.boxes);
+  std::vector<FlowBox> detected =
+      to_flow_boxes(use_raw ? masking_raw_boxes(result.detections) : result.detections.boxes);
   std::vector<bool> nms(detected.size(), true);
   if (use_raw) {
     for (size_t i = 0; i < detected.size(); ++i) {
       const auto& box = detected[i].box.box;
       nms[i] = std::any_of(result.detections.boxes.begin(), result.detections.boxes.end(),
-                           [&](const people::PersonBox& b) { return b.box == box; });
+                           [&](const PersonBox& b) { return b.box == box; });
     }
   }
   // Raw boxes move with the NMS box they overlap most: the flow is computed for the few NMS boxes only.
@@ -230,13 +230,13 @@ void PeopleStage::take_detection(people::WorkerResult result, const people::Flow
     flow(offered_, image, detected, &nms, &leader);
   }
   if (tracker_) {
-    const people::TrackerUpdate u = tracker_->update(people::to_person_boxes(detected));
+    const TrackerUpdate u = tracker_->update(to_person_boxes(detected));
     stats_.tracks_started += u.started;
     stats_.tracks_coasting += u.coasting;
-    std::vector<people::FlowBox> boxes = tracker_->flow_boxes();
-    std::vector<people::FlowBox> refreshed;
+    std::vector<FlowBox> boxes = tracker_->flow_boxes();
+    std::vector<FlowBox> refreshed;
     for (size_t i : tracker_->refreshed()) refreshed.push_back(boxes[i]);
-    people::seed_points(image.gray, refreshed, flow_options_);
+    seed_points(image.gray, refreshed, flow_options_);
     for (size_t k = 0; k < refreshed.size(); ++k)
       boxes[tracker_->refreshed()[k]].points = refreshed[k].points;
     tracker_->apply_moved(boxes);
@@ -255,10 +255,10 @@ void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv
   detection_ms_ = 0;
   if (mode_ == DetectorMode::kEveryFrame) {
     worker_->submit(index, colour);
-    if (tracker_) move_to(people::make_flow_image(gray, flow_options_));  // coasting tracks follow the image
+    if (tracker_) move_to(make_flow_image(gray, flow_options_));  // coasting tracks follow the image
     return;
   }
-  const people::FlowImage image = people::make_flow_image(gray, flow_options_);
+  const FlowImage image = make_flow_image(gray, flow_options_);
   move_to(image);
   if (auto result = worker_->poll()) take_detection(std::move(*result), image);
   const bool due = !offered_any_ || index >= offered_index_ + latest_interval_;
@@ -269,16 +269,16 @@ void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv
   }
 }
 
-std::vector<people::PersonBox> PeopleStage::masking_raw_boxes(const people::Detections& detections) {
+std::vector<PersonBox> PeopleStage::masking_raw_boxes(const Detections& detections) {
   int dropped = 0;
-  std::vector<people::PersonBox> raw =
-      people::raw_boxes_near_leaders(detections, raw_box_max_area_ratio_, &dropped);
+  std::vector<PersonBox> raw =
+      raw_boxes_near_leaders(detections, raw_box_max_area_ratio_, &dropped);
   stats_.raw_boxes_dropped += static_cast<std::size_t>(dropped);
   return raw;
 }
 
-void PeopleStage::current_boxes(std::vector<people::PersonBox>& filter_boxes,
-                                std::vector<people::PersonBox>& area_boxes) const {
+void PeopleStage::current_boxes(std::vector<PersonBox>& filter_boxes,
+                                std::vector<PersonBox>& area_boxes) const {
   filter_boxes.clear();
   area_boxes.clear();
   if (tracker_) {
@@ -292,12 +292,12 @@ void PeopleStage::current_boxes(std::vector<people::PersonBox>& filter_boxes,
   }
 }
 
-PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images, tracking::RawFeatures& raw,
+PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images, feature::RawFeatures& raw,
                                 bool record_keypoints) {
   PeopleFrame out;
-  std::vector<people::PersonBox> boxes, area_boxes;
+  std::vector<PersonBox> boxes, area_boxes;
   if (mode_ == DetectorMode::kEveryFrame) {
-    people::WorkerResult result = worker_->wait(index);
+    WorkerResult result = worker_->wait(index);
     out.detector_wait_ms = result.waited_ms;
     if (tracker_) {
       take_detection(std::move(result), current_);
@@ -321,7 +321,7 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   if (out.boxes_propagated) ++stats_.frames_propagated;
   const bool rgbd = sensor_ == io::SensorKind::kRgbd && !images.depth.empty();
   std::vector<float> depth_m;
-  if (filter_options_.mode == people::FilterMode::kDepth && rgbd) {
+  if (filter_options_.mode == FilterMode::kDepth && rgbd) {
     depth_m.resize(raw.keys.size(), -1.0f);
     for (size_t i = 0; i < raw.keys.size(); ++i) {
       const int x = cvRound(raw.keys[i].pt.x);
@@ -335,7 +335,7 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   // depth (and the flat-box test) works on them through a sparse depth image.
   cv::Mat stereo_depth;
   const bool stereo = sensor_ == io::SensorKind::kStereo && raw.depth_m.size() == raw.keys.size();
-  const bool depth_mode = filter_options_.mode == people::FilterMode::kDepth;
+  const bool depth_mode = filter_options_.mode == FilterMode::kDepth;
   if (stereo && !boxes.empty() && (depth_mode || flat_box_margin_m_ > 0)) {
     if (depth_mode) depth_m = raw.depth_m;
     stereo_depth = sparse_depth_image(raw.keys, raw.depth_m, images.colour.size(), kSparseDepthFactor);
@@ -349,23 +349,23 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     // test misjudges people (partly in view at the image's edge, or far away among others).
     const double min_area = kFlatTestMinArea * depth_image.cols * depth_image.rows;
     // The NMS boxes are among the raw boxes too: each box is tested once.
-    std::vector<std::pair<cv::Rect2f, people::BoxDepthVerdict>> tested;
-    auto verdict = [&](const people::PersonBox& b) {
-      if (b.box.area() < min_area) return people::BoxDepthVerdict::kUnknown;
+    std::vector<std::pair<cv::Rect2f, BoxDepthVerdict>> tested;
+    auto verdict = [&](const PersonBox& b) {
+      if (b.box.area() < min_area) return BoxDepthVerdict::kUnknown;
       for (const auto& [box, v] : tested) {
         if (box == b.box) return v;
       }
-      const auto v = people::box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict;
+      const auto v = box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict;
       tested.emplace_back(b.box, v);
       return v;
     };
     // A raw box is flat when it is found flat itself or when the NMS box it duplicates is
-    // (people::flat_by_leader).
-    const std::vector<people::PersonBox> nms_boxes = area_boxes;
-    std::vector<people::BoxDepthVerdict> nms_verdicts;
+    // (flat_by_leader).
+    const std::vector<PersonBox> nms_boxes = area_boxes;
+    std::vector<BoxDepthVerdict> nms_verdicts;
     for (const auto& b : nms_boxes) nms_verdicts.push_back(verdict(b));
-    auto flat = [&](const people::PersonBox& b) {
-      return people::flat_by_leader(b.box, verdict(b), nms_boxes, nms_verdicts);
+    auto flat = [&](const PersonBox& b) {
+      return flat_by_leader(b.box, verdict(b), nms_boxes, nms_verdicts);
     };
     const size_t before = area_boxes.size();
     area_boxes.erase(std::remove_if(area_boxes.begin(), area_boxes.end(), flat), area_boxes.end());
@@ -376,10 +376,10 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   }
   out.person_boxes = static_cast<int>(area_boxes.size());
   out.keypoints_before_filter = static_cast<int>(raw.keys.size());
-  const people::FilterResult filtered =
-      people::filter_keypoints(raw.keys, boxes, filter_options_, depth_m, depth_image, depth_factor);
+  const FilterResult filtered =
+      filter_keypoints(raw.keys, boxes, filter_options_, depth_m, depth_image, depth_factor);
   if (filtered.removed > 0) {
-    tracking::RawFeatures kept;
+    feature::RawFeatures kept;
     kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));
     kept.descriptors.create(static_cast<int>(raw.keys.size()) - filtered.removed, raw.descriptors.cols,
                             raw.descriptors.type());
@@ -420,10 +420,10 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   // raw boxes overlap heavily, and their summed area says nothing about how much of the image people cover.
   budget_options_.image_width = images.colour.cols;
   budget_options_.image_height = images.colour.rows;
-  out.people_area = people::covered_fraction(area_boxes, images.colour.cols, images.colour.rows, area_mode_);
-  next_feature_budget_ = people::feature_budget(out.people_area, budget_options_);
+  out.people_area = covered_fraction(area_boxes, images.colour.cols, images.colour.rows, area_mode_);
+  next_feature_budget_ = feature_budget(out.people_area, budget_options_);
   out.boxes = std::move(boxes);
   return out;
 }
 
-}  // namespace crowdslam::system
+}  // namespace crowdslam::people

@@ -1,7 +1,7 @@
 #pragma once
 // Rectification of raw stereo pairs (EuRoC) before feature extraction.
 //
-// The rectification comes from a settings file's LEFT/RIGHT blocks (K, D, R, P per camera, ORB-SLAM2
+// The rectification (io::Settings::rectification) comes from a settings file's LEFT/RIGHT blocks (K, D, R, P per camera, ORB-SLAM2
 // EuRoC style) or is computed from the EuRoC sensor.yaml calibration (intrinsics, radial-tangential
 // distortion, T_BS) with cv::stereoRectify (zero disparity at infinity, alpha 0: only valid pixels, same
 // image size). Either way Camera.* of the settings describe the rectified left image: fx, fy, cx, cy =
@@ -11,16 +11,28 @@
 
 #include <opencv2/core.hpp>
 
-#include "crowdslam/geometry/se3.h"
-#include "crowdslam/io/euroc_dataset.h"
-#include "crowdslam/io/settings.h"
+namespace crowdslam::geometry {
 
-namespace crowdslam::system {
+// One camera of a stereo rectification (ORB-SLAM2's LEFT/RIGHT settings blocks): the raw camera's K and D,
+// the rectifying rotation R and the rectified projection P.
+struct RectificationSide {
+  int width = 0;
+  int height = 0;
+  cv::Mat K;  // 3x3 CV_64F
+  cv::Mat D;  // 1xN CV_64F (4, 5, 8, 12 or 14 coefficients)
+  cv::Mat R;  // 3x3 CV_64F
+  cv::Mat P;  // 3x4 CV_64F
+};
+
+struct StereoRectification {
+  RectificationSide left;
+  RectificationSide right;
+};
 
 class StereoRectifier {
  public:
   // Precomputes the remap tables. `source` names where the rectification came from, for error messages.
-  StereoRectifier(const io::StereoRectification& rectification, const std::string& source);
+  StereoRectifier(const StereoRectification& rectification, const std::string& source);
 
   // Rectified images (bilinear). Throws InputError when an image's size is not LEFT/RIGHT.width x height.
   void rectify_left(const cv::Mat& raw, cv::Mat& rectified) const;
@@ -37,15 +49,4 @@ class StereoRectifier {
   cv::Mat right_map1_, right_map2_;
 };
 
-// LEFT/RIGHT blocks for an EuRoC pair from its sensor.yaml calibrations. right_from_left maps points from
-// the left (cam0) to the right (cam1) camera frame. Throws InputError (naming `source`) for a
-// distortion model other than radial-tangential or cameras of different resolutions.
-io::StereoRectification rectification_from_euroc(const io::EurocCameraCalibration& left,
-                                                 const io::EurocCameraCalibration& right,
-                                                 const geometry::Mat4& right_from_left, const std::string& source);
-
-// Sets settings.rectification and Camera.* (fx, fy, cx, cy from LEFT.P, bf = -RIGHT.P(0,3), distortion
-// zero, width and height of the rectified images).
-void apply_rectification(io::Settings& settings, const io::StereoRectification& rectification);
-
-}  // namespace crowdslam::system
+}  // namespace crowdslam::geometry

@@ -1,0 +1,1 @@
+// Owner of the libraries' precompiled header (cmake/BuildSpeed.cmake); compiles to nothing.
