@@ -148,6 +148,7 @@ class System:
         filter_mode: Optional[str] = None,
         record_keypoints: bool = False,
         max_wait_for_mapping_ms: float = 1000.0,
+        replay_waits_for_mapping: bool = True,
     ) -> None: ...
     def __enter__(self) -> System: ...
     def __exit__(
