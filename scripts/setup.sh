@@ -53,12 +53,18 @@ else
   echo "setup: building everything with $jobs jobs (ninja shows [done/total])"
 fi
 cmake --build "$build_dir" -j "$jobs" "${targets[@]}"
-echo "setup: default vocabulary and person-detector models"
+echo "setup: default vocabulary, person-detector models and person sprites"
 
 # Default ORB vocabulary (vocabulary/crowdslam_orb.voc, never committed): trained from opencv-doc's
 # sample images in about 10 s; skipped when present with the recorded SHA-256.
 if ! bash scripts/build_vocabulary.sh "$build_dir" >/dev/null; then
   echo "setup: warning: default vocabulary not built (see the error above)" >&2
+fi
+
+# Person sprites for `crowdslam synth` (people_sprites/, never committed): people cut out of the MOT
+# sequences in ../shared; skipped when complete. Without them synth's people are textured boxes.
+if ! bash scripts/build_people_sprites.sh "$build_dir" >/dev/null; then
+  echo "setup: warning: person sprites not built (see the error above)" >&2
 fi
 
 # Person-detector models (copied from ../shared or downloaded with a SHA-256 check; never committed).

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "crowdslam/synth/sprites.h"
 #include "crowdslam/synth/writer.h"
 #include "crowdslam/util/interrupt.h"
 #include "crowdslam/util/progress.h"
@@ -16,6 +17,8 @@ void add_synth_command(CLI::App& app, GlobalOptions& global) {
   struct Args {
     std::string out;
     std::string trajectory = "loop";
+    std::string crowd = "auto";
+    std::string sprites;
     synth::SynthOptions options;
   };
   auto args = std::make_shared<Args>();
@@ -38,9 +41,21 @@ void add_synth_command(CLI::App& app, GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--textures", args->options.texture_dir, "Directory of photographs used as textures")
       ->capture_default_str();
+  cmd->add_option("--crowd", args->crowd,
+                  "How the people behave: auto (passing with sprites, walk with box people), walk, passing, "
+                  "standing, near or blackout")
+      ->capture_default_str();
+  cmd->add_option(
+      "--sprites", args->sprites,
+      "Person sprites (crowdslam synth-sprites) for billboard people; default <repo>/people_sprites "
+      "when built; 'none' for textured box people");
   cmd->add_flag("--force", args->options.force, "Replace an existing non-empty output directory");
   cmd->callback([args, &global] {
     args->options.trajectory = synth::parse_trajectory_kind(args->trajectory);
+    args->options.crowd = synth::parse_crowd_profile(args->crowd);
+    const synth::SpriteChoice sprites = synth::resolve_sprite_dir(args->sprites);
+    args->options.sprite_dir = sprites.dir;
+    if (args->options.people > 0 && !sprites.notice.empty()) spdlog::warn("{}", sprites.notice);
     InterruptScope interrupts;  // a signal stops the rendering and removes the unfinished output
     ProgressLine progress(!global.quiet, static_cast<size_t>(args->options.frames), "frame");
     const synth::SequenceSummary s =
@@ -54,13 +69,17 @@ void add_synth_command(CLI::App& app, GlobalOptions& global) {
                        {"person_boxes", s.person_boxes},
                        {"max_person_coverage", s.max_person_coverage},
                        {"textures", s.photo_textures ? "photos" : "procedural"},
+                       {"people_model", s.sprite_people ? "sprites" : "boxes"},
+                       {"crowd", s.crowd},
                        {"seconds", s.seconds}};
       if (std::isfinite(s.min_person_distance_m)) j["min_person_distance_m"] = s.min_person_distance_m;
       print_json(j);
       return;
     }
-    spdlog::info("synth: wrote {} frames to {} in {:.1f} s ({} person boxes, textures: {})", s.frames, args->out,
-                 s.seconds, s.person_boxes, s.photo_textures ? "photos" : "procedural");
+    spdlog::info(
+        "synth: wrote {} frames to {} in {:.1f} s ({} person boxes, textures: {}, people: {}, crowd: {})",
+        s.frames, args->out, s.seconds, s.person_boxes, s.photo_textures ? "photos" : "procedural",
+        s.sprite_people ? "sprites" : "boxes", s.crowd);
     if (std::isfinite(s.min_person_distance_m)) {
       spdlog::info("synth: closest person to the camera {:.2f} m, largest image coverage {:.0f}%",
                    s.min_person_distance_m, 100.0 * s.max_person_coverage);

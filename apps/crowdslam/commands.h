@@ -20,6 +20,7 @@ struct GlobalOptions {
 void add_dataset_command(CLI::App& app, const GlobalOptions& global);
 void add_eval_command(CLI::App& app, const GlobalOptions& global);
 void add_synth_command(CLI::App& app, GlobalOptions& global);
+void add_synth_sprites_command(CLI::App& app, const GlobalOptions& global);
 void add_run_command(CLI::App& app, GlobalOptions& global);
 void add_detect_command(CLI::App& app, const GlobalOptions& global);
 void add_vocab_command(CLI::App& app, const GlobalOptions& global);

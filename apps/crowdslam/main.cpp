@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   add_dataset_command(app, global);
   add_eval_command(app, global);
   add_synth_command(app, global);
+  add_synth_sprites_command(app, global);
   add_run_command(app, global);
   add_detect_command(app, global);
   add_vocab_command(app, global);

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <vector>
+
+#include "test_support.h"
 
 namespace crowdslam::synth::test {
 namespace {
@@ -59,6 +63,44 @@ Consistency check_consistency(const cv::Mat& colour_i, const cv::Mat& depth_i, c
     result.median_grey_diff = diffs[diffs.size() / 2];
   }
   return result;
+}
+
+bool test_sprite_opaque(int x, int y) {
+  const bool head = (x - 30) * (x - 30) + (y - 14) * (y - 14) <= 12 * 12;
+  const bool neck = x >= 25 && x < 35 && y >= 24 && y < 30;
+  const bool torso = x >= 10 && x < 50 && y >= 28 && y < 92;
+  const bool arms = (x >= 2 && x < 10 && y >= 30 && y < 86) || (x >= 50 && x < 58 && y >= 30 && y < 86);
+  const bool legs = ((x >= 13 && x < 28) || (x >= 32 && x < 47)) && y >= 92 && y < 160;
+  return head || neck || torso || arms || legs;
+}
+
+void write_test_sprites(const std::filesystem::path& dir, int count, bool opaque_rectangles) {
+  std::filesystem::create_directories(dir);
+  nlohmann::json list{{"generator", "test"}, {"count", count}, {"sprites", nlohmann::json::array()}};
+  for (int i = 0; i < count; ++i) {
+    cv::Mat sprite(160, 60, CV_8UC4, cv::Scalar::all(0));
+    const cv::Vec3b shirt((37 * i + 40) % 256, (91 * i + 120) % 256, (53 * i + 200) % 256);
+    const cv::Vec3b trousers((29 * i + 30) % 128, (17 * i + 20) % 128, (43 * i + 60) % 128);
+    for (int y = 0; y < sprite.rows; ++y) {
+      for (int x = 0; x < sprite.cols; ++x) {
+        if (!opaque_rectangles && !test_sprite_opaque(x, y)) continue;
+        const cv::Vec3b c = y < 28 ? cv::Vec3b(120, 160, 210) : (y < 92 ? shirt : trousers);
+        const uchar grain = static_cast<uchar>(((x * 7 + y * 13) % 5) * 8);  // some texture for corners
+        sprite.at<cv::Vec4b>(y, x) = cv::Vec4b(cv::saturate_cast<uchar>(c[0] + grain), c[1], c[2], 255);
+      }
+    }
+    const std::string name = "test_" + std::to_string(i) + ".png";
+    cv::imwrite((dir / name).string(), sprite);
+    list["sprites"].push_back({{"file", name},
+                               {"sequence", "test"},
+                               {"frame", 1},
+                               {"id", i + 1},
+                               {"width", 60},
+                               {"height", 160},
+                               {"fill", 0.6},
+                               {"facing", 1}});
+  }
+  crowdslam::test::write_text(dir / "sprites.json", list.dump(2));
 }
 
 }  // namespace crowdslam::synth::test

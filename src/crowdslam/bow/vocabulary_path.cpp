@@ -3,16 +3,14 @@
 #include <cstdlib>
 #include <filesystem>
 
-#ifndef CROWDSLAM_SOURCE_DIR
-#define CROWDSLAM_SOURCE_DIR "."
-#endif
+#include "crowdslam/util/project_paths.h"
 
 namespace crowdslam::bow {
 
 std::string default_vocabulary_path() {
   if (const char* value = std::getenv("CROWDSLAM_VOCABULARY"); value != nullptr && *value != '\0')
     return value;
-  return (std::filesystem::path(CROWDSLAM_SOURCE_DIR) / "vocabulary" / "crowdslam_orb.voc").string();
+  return (util::source_dir() / "vocabulary" / "crowdslam_orb.voc").string();
 }
 
 }  // namespace crowdslam::bow

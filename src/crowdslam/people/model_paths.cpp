@@ -5,13 +5,8 @@
 #include <vector>
 
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/project_paths.h"
 
-#ifndef CROWDSLAM_DEFAULT_SHARED
-#define CROWDSLAM_DEFAULT_SHARED "../shared"
-#endif
-#ifndef CROWDSLAM_SOURCE_DIR
-#define CROWDSLAM_SOURCE_DIR "."
-#endif
 
 namespace crowdslam::people {
 namespace fs = std::filesystem;
@@ -30,9 +25,8 @@ bool ends_with(const std::string& text, const std::string& suffix) {
 std::vector<std::string> model_dir_candidates() {
   std::vector<std::string> candidates;
   if (const std::string models = env("CROWDSLAM_MODELS"); !models.empty()) candidates.push_back(models);
-  candidates.push_back((fs::path(CROWDSLAM_SOURCE_DIR) / "models").string());
-  const std::string shared = env("CROWDSLAM_SHARED");
-  candidates.push_back((fs::path(shared.empty() ? CROWDSLAM_DEFAULT_SHARED : shared) / "models").string());
+  candidates.push_back((util::source_dir() / "models").string());
+  candidates.push_back((util::shared_dir() / "models").string());
   return candidates;
 }
 

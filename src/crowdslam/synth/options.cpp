@@ -24,6 +24,48 @@ std::string to_string(TrajectoryKind kind) {
   return "loop";
 }
 
+CrowdProfile parse_crowd_profile(const std::string& name) {
+  if (name == "auto") return CrowdProfile::kAuto;
+  if (name == "walk") return CrowdProfile::kWalk;
+  if (name == "passing") return CrowdProfile::kPassing;
+  if (name == "standing") return CrowdProfile::kStanding;
+  if (name == "near") return CrowdProfile::kNear;
+  if (name == "blackout") return CrowdProfile::kBlackout;
+  throw InputError("--crowd: unknown crowd profile '" + name +
+                   "' (expected auto, walk, passing, standing, near or blackout)");
+}
+
+std::string to_string(CrowdProfile profile) {
+  switch (profile) {
+    case CrowdProfile::kAuto:
+      return "auto";
+    case CrowdProfile::kWalk:
+      return "walk";
+    case CrowdProfile::kPassing:
+      return "passing";
+    case CrowdProfile::kStanding:
+      return "standing";
+    case CrowdProfile::kNear:
+      return "near";
+    case CrowdProfile::kBlackout:
+      return "blackout";
+  }
+  return "auto";
+}
+
+CrowdProfile SynthOptions::resolved_crowd() const {
+  if (crowd != CrowdProfile::kAuto) return crowd;
+  return sprite_dir.empty() ? CrowdProfile::kWalk : CrowdProfile::kPassing;
+}
+
+double SynthOptions::room_scale() const {
+  const CrowdProfile profile = resolved_crowd();
+  if (profile == CrowdProfile::kWalk) return 1.0;
+  // Groups stand between the camera's path and the walls, where the small room has little floor.
+  const int fits = profile == CrowdProfile::kStanding ? 8 : 12;
+  return people <= fits ? 1.0 : std::sqrt(static_cast<double>(people) / fits);
+}
+
 void SynthOptions::check() const {
   if (frames < 1 || frames > 1000000) {
     throw InputError("--frames: must be between 1 and 1000000, got " + std::to_string(frames));

@@ -134,6 +134,20 @@ Eigen::Vector2d initial_position(const WalkArea& area, const Walker& walker,
 
 }  // namespace
 
+const char* to_string(PersonRole role) {
+  switch (role) {
+    case PersonRole::kWalker:
+      return "walker";
+    case PersonRole::kGroup:
+      return "group";
+    case PersonRole::kNear:
+      return "near";
+    case PersonRole::kBlackout:
+      return "blackout";
+  }
+  return "walker";
+}
+
 std::vector<PersonTrack> simulate_people(int count, const io::Trajectory& camera, const WalkArea& area,
                                          std::uint64_t seed) {
   std::vector<PersonTrack> tracks(count);

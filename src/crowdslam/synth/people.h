@@ -27,8 +27,14 @@ struct PersonState {
   double body_yaw = 0.0;  // direction the person faces (radians, about z)
 };
 
+// What a person does (crowd.h): walk about, stand in a group, cross close in front of the camera, or
+// belong to the group that blacks out the view.
+enum class PersonRole { kWalker, kGroup, kNear, kBlackout };
+const char* to_string(PersonRole role);
+
 struct PersonTrack {
   int id = 0;  // 1-based
+  PersonRole role = PersonRole::kWalker;
   double speed_mps = 0.0;
   std::vector<PersonState> states;  // one per frame
 };

@@ -89,6 +89,7 @@ class SequenceWriter {
     fs::create_directories(dir_ / (stereo ? "image_0" : "rgb"));
     fs::create_directories(dir_ / (stereo ? "image_1" : "depth"));
     if (o.movers > 0) fs::create_directories(dir_ / "mask");
+    if (scene_.sprite_people()) fs::create_directories(dir_ / "people_mask");
     results_.assign(scene_.frame_count(), {});
     const int threads = std::max(1, std::min(8, static_cast<int>(std::thread::hardware_concurrency())));
     std::vector<std::thread> pool;
@@ -123,15 +124,18 @@ class SequenceWriter {
     const std::string name = frame_name(frame);
     const geometry::SE3& world_from_cam = scene_.trajectory()[frame].world_from_cam;
     const std::vector<Box> people = scene_.moving_boxes(frame);
-    const RenderedFrame left = render(scene_, world_from_cam, people);
+    const std::vector<Billboard> billboards = scene_.people_billboards(frame);  // facing the left camera
+    const RenderedFrame left = render(scene_, world_from_cam, people, billboards);
     if (o.stereo) {
       write_png(dir_ / "image_0" / name, left.colour);
-      write_png(dir_ / "image_1" / name, render(scene_, scene_.right_world_from_cam(frame), people).colour);
+      write_png(dir_ / "image_1" / name,
+                render(scene_, scene_.right_world_from_cam(frame), people, billboards).colour);
     } else {
       write_png(dir_ / "rgb" / name, left.colour);
       write_png(dir_ / "depth" / name, depth_png(left.depth_m, o.noise_depth_m, Rng(o.seed, 0xde97ULL + frame)));
     }
     if (o.movers > 0) write_png(dir_ / "mask" / name, left.moving);
+    if (scene_.sprite_people()) write_png(dir_ / "people_mask" / name, left.person_label);
     FrameResult& result = results_[frame];
     result.boxes = visible_person_boxes(scene_, left, world_from_cam, frame);
     result.coverage = static_cast<double>(cv::countNonZero(left.person_label)) / left.person_label.total();
@@ -170,13 +174,18 @@ std::string calib_txt(const Intrinsics& k) {
   return row("P0", 0.0) + row("P1", right_tx) + row("P2", 0.0) + row("P3", right_tx);
 }
 
-std::string people_gt(const std::vector<FrameResult>& results) {
+std::string people_gt(const std::vector<FrameResult>& results, bool with_visibility) {
   std::ostringstream out;
   char line[160];
   for (size_t f = 0; f < results.size(); ++f) {
     for (const PersonBox& p : results[f].boxes) {
-      std::snprintf(line, sizeof line, "%zu,%d,%.2f,%.2f,%.2f,%.2f,1,-1,-1,-1\n", f + 1, p.id, p.box.x, p.box.y,
-                    p.box.width, p.box.height);
+      if (with_visibility) {
+        std::snprintf(line, sizeof line, "%zu,%d,%.2f,%.2f,%.2f,%.2f,1,1,%.4f\n", f + 1, p.id, p.box.x,
+                      p.box.y, p.box.width, p.box.height, p.visibility);
+      } else {
+        std::snprintf(line, sizeof line, "%zu,%d,%.2f,%.2f,%.2f,%.2f,1,-1,-1,-1\n", f + 1, p.id, p.box.x,
+                      p.box.y, p.box.width, p.box.height);
+      }
       out << line;
     }
   }
@@ -187,6 +196,8 @@ SequenceSummary summarise(const Scene& scene, const std::vector<FrameResult>& re
   SequenceSummary s;
   s.frames = scene.frame_count();
   s.photo_textures = scene.photo_textures();
+  s.sprite_people = scene.sprite_people();
+  s.crowd = to_string(scene.crowd());
   s.min_person_distance_m = std::numeric_limits<double>::infinity();
   for (const FrameResult& r : results) {
     s.person_boxes += static_cast<int>(r.boxes.size());
@@ -225,6 +236,30 @@ nlohmann::json synth_json(const Scene& scene, const SequenceSummary& summary) {
   j["baseline_m"] = o.stereo ? kStereoBaselineM : 0.0;
   j["intrinsics"] = {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}};
   j["textures"] = scene.photo_textures() ? "photos" : "procedural";
+  j["crowd"] = to_string(scene.crowd());
+  j["room_scale"] = o.room_scale();
+  if (scene.sprite_people()) {
+    j["people_model"] = "sprites";
+    j["sprites"] = o.sprite_dir;
+    j["person_mask"] = "people_mask";  // people_mask/NNNNNN.png: 16-bit person id, 0 = no person
+    j["people_gt"] = "frame,id,x,y,w,h,1,1,visibility";
+  } else {
+    j["people_model"] = "boxes";
+    j["people_gt"] = "frame,id,x,y,w,h,1,-1,-1,-1";
+  }
+  if (scene.blackout_frames().first >= 0) {
+    j["blackout_frames"] = {scene.blackout_frames().first, scene.blackout_frames().second};
+  }
+  j["persons"] = nlohmann::json::array();
+  for (size_t i = 0; i < scene.people().size(); ++i) {
+    const PersonTrack& t = scene.people()[i];
+    nlohmann::json person{{"id", t.id}, {"role", to_string(t.role)}};
+    if (scene.sprite_people()) {
+      person["sprite"] = scene.sprites()[scene.person_sprite(static_cast<int>(i))].record.file;
+      person["height_m"] = scene.person_height_m(static_cast<int>(i));
+    }
+    j["persons"].push_back(person);
+  }
   j["person_boxes"] = summary.person_boxes;
   j["max_person_coverage"] = summary.max_person_coverage;
   if (std::isfinite(summary.min_person_distance_m)) j["min_person_distance_m"] = summary.min_person_distance_m;
@@ -246,14 +281,51 @@ void write_text_files(const Scene& scene, const fs::path& dir, const std::vector
   }
   io::write_tum_trajectory((dir / "groundtruth.txt").string(), scene.trajectory());
   write_file_atomic(dir / "settings.yaml", settings_yaml(o));
-  write_file_atomic(dir / "people_gt.txt", people_gt(results));
+  write_file_atomic(dir / "people_gt.txt", people_gt(results, scene.sprite_people()));
   write_file_atomic(dir / "synth.json", synth_json(scene, summary).dump(2) + "\n");
+}
+
+}  // namespace
+
+namespace {
+
+std::vector<PersonBox> billboard_person_boxes(const Scene& scene, const RenderedFrame& rendered,
+                                              const geometry::SE3& world_from_cam, int frame) {
+  const int count = static_cast<int>(scene.people().size());
+  std::vector<int> visible(count + 1, 0);
+  for (int y = 0; y < rendered.person_label.rows; ++y) {
+    const auto* row = rendered.person_label.ptr<std::uint16_t>(y);
+    for (int x = 0; x < rendered.person_label.cols; ++x) {
+      if (row[x] > 0 && row[x] <= count) ++visible[row[x]];
+    }
+  }
+  const Intrinsics& k = scene.intrinsics();
+  std::vector<PersonBox> boxes;
+  for (const Billboard& b : scene.people_billboards(frame)) {
+    if (visible[b.person_id] == 0) continue;
+    const BillboardFootprint f = billboard_footprint(scene, b, world_from_cam);
+    if (f.pixels == 0) continue;  // cannot happen: every visible pixel is one of the footprint's
+    const double x0 = std::max(0.0, f.min_u - 0.5);
+    const double y0 = std::max(0.0, f.min_v - 0.5);
+    const double x1 = std::min(k.width - 1.0, f.max_u + 0.5);
+    const double y1 = std::min(k.height - 1.0, f.max_v + 0.5);
+    PersonBox p;
+    p.id = b.person_id;
+    p.box = cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+    p.visible_pixels = visible[b.person_id];
+    p.pixels = f.pixels;
+    p.unbounded_pixels = f.unbounded_pixels;
+    p.visibility = std::min(1.0, p.visible_pixels / f.unbounded_pixels);
+    boxes.push_back(p);
+  }
+  return boxes;
 }
 
 }  // namespace
 
 std::vector<PersonBox> visible_person_boxes(const Scene& scene, const RenderedFrame& rendered,
                                             const geometry::SE3& world_from_cam, int frame) {
+  if (scene.sprite_people()) return billboard_person_boxes(scene, rendered, world_from_cam, frame);
   const int count = static_cast<int>(scene.people().size());
   std::vector<bool> seen(count + 1, false);
   for (int y = 0; y < rendered.person_label.rows; ++y) {
