@@ -26,6 +26,10 @@ void print_summary(const run::RunSummary& summary) {
             << "tracking ms       median " << summary.tracking_ms_median << ", p95 "
             << summary.tracking_ms_p95 << "\n"
             << "extraction ms     median " << summary.extraction_ms_median << "\n";
+  if (summary.bridged > 0) {
+    std::cout << "bridged           " << summary.bridged
+              << " (people hid the view; motion-model poses in BridgedTrajectory.txt)\n";
+  }
   if (summary.init_frame) std::cout << "initialised at    frame " << *summary.init_frame << "\n";
   if (summary.segments.size() > 1) {
     std::cout << "maps              " << summary.segments.size() << " (the map was reset "

@@ -176,3 +176,32 @@ TEST(BoxDepth, ARawBoxIsFlatWhenItOrTheNmsBoxItDuplicatesIsFlat) {
   EXPECT_FALSE(flat_by_leader({600, 0, 30, 30}, BoxDepthVerdict::kUnknown, nms, verdicts));
   EXPECT_FALSE(flat_by_leader({120, 60, 150, 320}, BoxDepthVerdict::kUnknown, {}, {}));
 }
+
+TEST(BoxDepth, APersonAmongPeopleIsNotJudgedFlatOnTheNeighboursBesideThem) {
+  // A row of three people 0.6 m from the camera hides a wall 3 m away from edge to edge: the patches
+  // beside each box show the neighbours, at the person's own depth.
+  cv::Mat depth = plane_image(kFrontal, 3.0);
+  const cv::Rect2f boxes[3] = {{0, 0, 220, 480}, {210, 0, 220, 480}, {420, 0, 220, 480}};
+  for (const auto& b : boxes) add_slab(depth, cv::Rect(b), 2.4);
+  const std::vector<cv::Rect2f> people(std::begin(boxes), std::end(boxes));
+  // Judged on the neighbours (the test's behaviour without the other boxes): flat, so not filtered.
+  EXPECT_EQ(box_depth_test(depth, kFactor, boxes[1], 0.2).verdict, BoxDepthVerdict::kFlat);
+  // With the other people's boxes, no patch shows the surface behind the middle person: undecided, kept.
+  for (const auto& b : boxes) {
+    EXPECT_NE(box_depth_test(depth, kFactor, b, 0.2, people).verdict, BoxDepthVerdict::kFlat);
+  }
+  // A box's own duplicate (IoU >= 0.5) is not another person: a poster is still flat with its raw twin.
+  const cv::Mat wall = plane_image(kFrontal, 3.0);
+  const cv::Rect2f poster(250, 100, 140, 250);
+  const std::vector<cv::Rect2f> twin = {cv::Rect2f(255, 105, 140, 250)};
+  EXPECT_EQ(box_depth_test(wall, kFactor, poster, 0.2, twin).verdict, BoxDepthVerdict::kFlat);
+  // A person beside the middle one, 1 m in front of the wall, with the wall visible beyond them both:
+  // judged on the wall, they stand out.
+  cv::Mat pair = plane_image(kFrontal, 3.0);
+  const cv::Rect2f left(200, 100, 100, 300), right(300, 100, 100, 300);
+  add_slab(pair, cv::Rect(left), 1.0);
+  add_slab(pair, cv::Rect(right), 1.0);
+  const std::vector<cv::Rect2f> both = {left, right};
+  EXPECT_EQ(box_depth_test(pair, kFactor, left, 0.2, both).verdict, BoxDepthVerdict::kStandsOut);
+  EXPECT_EQ(box_depth_test(pair, kFactor, right, 0.2, both).verdict, BoxDepthVerdict::kStandsOut);
+}

@@ -89,6 +89,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.text("PeopleFilter.mode"), s.people_filter.mode);
   set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
   set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
+  set_if(r.flag("PeopleFilter.silhouettes"), s.people_filter.silhouettes);
   set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
   set_if(r.text("PeopleFilter.static_in_boxes"), s.people_filter.static_in_boxes);
   set_if(r.integer("PeopleFilter.static_check_below"), s.people_filter.static_check_below);
@@ -106,6 +107,8 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.integer("Geometry.region_steps"), s.geometry.region_steps);
   set_if(r.integer("Geometry.free_space_cull_run"), s.geometry.free_space_cull_run);
   set_if(r.integer("Tracking.odometry_bridge_min_inliers"), s.tracking.odometry_bridge_min_inliers);
+  set_if(r.real("Tracking.bridge_max_s"), s.tracking.bridge_max_s);
+  set_if(r.real("Tracking.bridge_min_people_share"), s.tracking.bridge_min_people_share);
   set_if(r.flag("Ground.enabled"), s.ground.enabled);
   set_if(r.real("Ground.keyframe_sigma"), s.ground.keyframe_sigma);
   set_if(r.flag("FeatureBudget.enabled"), s.feature_budget.enabled);
@@ -188,6 +191,7 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.people_filter.mode == b.people_filter.mode &&
                       a.people_filter.margin_px == b.people_filter.margin_px &&
                       a.people_filter.depth_margin_m == b.people_filter.depth_margin_m &&
+                      a.people_filter.silhouettes == b.people_filter.silhouettes &&
                       a.people_filter.right_image == b.people_filter.right_image &&
                       a.people_filter.flat_box_margin_m == b.people_filter.flat_box_margin_m;
   const auto& ga = a.geometry;
@@ -203,7 +207,9 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.feature_budget.thresholds == b.feature_budget.thresholds &&
                       a.feature_budget.factors == b.feature_budget.factors &&
                       a.feature_budget.area == b.feature_budget.area;
-  const bool tracking = a.tracking.odometry_bridge_min_inliers == b.tracking.odometry_bridge_min_inliers;
+  const bool tracking = a.tracking.odometry_bridge_min_inliers == b.tracking.odometry_bridge_min_inliers &&
+                        a.tracking.bridge_max_s == b.tracking.bridge_max_s &&
+                        a.tracking.bridge_min_people_share == b.tracking.bridge_min_people_share;
   const bool ground = a.ground.enabled == b.ground.enabled && a.ground.keyframe_sigma == b.ground.keyframe_sigma;
   return camera && orb && detector && people && geometry && tracking && ground && budget && a.th_depth == b.th_depth &&
          a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&

@@ -81,6 +81,8 @@ struct PeopleFilterSettings {
   double margin_px = 5.0;
   double depth_margin_m =
       1.0;  // "depth" mode: keypoints this far behind the person are kept (measured: 1.0 best)
+  // "depth" mode: a kept keypoint whose patch core shows the person (their silhouette) is dropped too.
+  bool silhouettes = false;
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the
   // stereo match of a kept left keypoint whose right coordinate falls in a (left-image) person box.
   std::string right_image = "matched";
@@ -120,6 +122,11 @@ struct TrackingSettings {
   // RGB-D / stereo: inliers among the last frame's points, its depth points included, that let the
   // motion model track a frame seeing too few map points, and make it a keyframe (0 = off).
   int odometry_bridge_min_inliers = 50;
+  // Occlusion bridge: a frame that fails while people took at least this share of its keypoints gets the
+  // motion model's pose (state "bridged", not tracked) for up to bridge_max_s after the last tracked frame,
+  // and no new map is started meanwhile (0 = off).
+  double bridge_max_s = 3.0;
+  double bridge_min_people_share = 0.5;
 };
 
 // A monocular camera that rides at a constant height above planar ground (on a car or a ground robot):

@@ -226,6 +226,11 @@ void check_own_sections(const Checker& c, const Settings& s) {
             "in [1, 8]", g.free_space_cull_run);
   c.require(s.tracking.odometry_bridge_min_inliers >= 0, "Tracking.odometry_bridge_min_inliers", ">= 0 (0 = off)",
             s.tracking.odometry_bridge_min_inliers);
+  c.require(std::isfinite(s.tracking.bridge_max_s) && s.tracking.bridge_max_s >= 0 && s.tracking.bridge_max_s <= 60,
+            "Tracking.bridge_max_s", "in [0, 60] seconds (0 = off)", s.tracking.bridge_max_s);
+  c.require(std::isfinite(s.tracking.bridge_min_people_share) && s.tracking.bridge_min_people_share >= 0 &&
+                s.tracking.bridge_min_people_share <= 1,
+            "Tracking.bridge_min_people_share", "in [0, 1]", s.tracking.bridge_min_people_share);
   c.require(std::isfinite(s.ground.keyframe_sigma) && s.ground.keyframe_sigma > 0 && s.ground.keyframe_sigma <= 1,
             "Ground.keyframe_sigma", "in (0, 1] (relative to the camera's height)", s.ground.keyframe_sigma);
   const auto& b = s.feature_budget;

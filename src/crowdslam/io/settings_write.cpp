@@ -105,6 +105,7 @@ void write_own_sections(std::ostream& out, const Settings& s) {
   out << "# Keypoints on people (mode \"paper\" or \"depth\")\nPeopleFilter.enabled: " << (p.enabled ? 1 : 0)
       << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
       << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
+      << "\nPeopleFilter.silhouettes: " << (p.silhouettes ? 1 : 0)
       << "\nPeopleFilter.right_image: " << quoted(p.right_image)
       << "\nPeopleFilter.static_in_boxes: " << quoted(p.static_in_boxes)
       << "\nPeopleFilter.static_check_below: " << p.static_check_below
@@ -121,8 +122,10 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nGeometry.free_space_margin_m: " << real_text(g.free_space_margin_m)
       << "\nGeometry.free_space_ratio: " << real_text(g.free_space_ratio)
       << "\nGeometry.free_space_cull_run: " << g.free_space_cull_run << "\n\n";
-  out << "# Tracking through views the map does not cover (RGB-D / stereo)\nTracking.odometry_bridge_min_inliers: "
-      << s.tracking.odometry_bridge_min_inliers << "\n\n";
+  out << "# Tracking through views the map does not cover (RGB-D / stereo), and through people hiding it\n"
+      << "Tracking.odometry_bridge_min_inliers: " << s.tracking.odometry_bridge_min_inliers
+      << "\nTracking.bridge_max_s: " << real_text(s.tracking.bridge_max_s)
+      << "\nTracking.bridge_min_people_share: " << real_text(s.tracking.bridge_min_people_share) << "\n\n";
   out << "# A monocular camera at a constant height above the ground (a car's)\nGround.enabled: "
       << (s.ground.enabled ? 1 : 0) << "\nGround.keyframe_sigma: " << real_text(s.ground.keyframe_sigma) << "\n\n";
   const auto& b = s.feature_budget;

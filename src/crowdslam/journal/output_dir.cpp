@@ -15,8 +15,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const char* const kOutputNames[] = {"CameraTrajectory.txt", "KeyFrameTrajectory.txt", "run.json", "frames",
-                                    "report.html"};
+const char* const kOutputNames[] = {"CameraTrajectory.txt", "KeyFrameTrajectory.txt", "BridgedTrajectory.txt",
+                                    "run.json", "frames", "report.html"};
 
 std::string where(const fs::path& path) { return clip_text(path.string(), 200); }
 

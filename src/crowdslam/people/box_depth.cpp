@@ -59,10 +59,21 @@ std::vector<uint16_t> sample_valid_depths(const cv::Mat& depth_image_raw, const 
 }
 
 BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
-                            double margin_m) {
+                            double margin_m, const std::vector<cv::Rect2f>& other_people) {
   BoxDepthTest test;
   if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1 || !(depth_factor > 0)) return test;
   if (!(box.width > 1) || !(box.height > 1)) return test;
+  std::vector<cv::Rect2f> others;
+  for (const auto& o : other_people) {
+    const float overlap = (o & box).area();
+    if (overlap < 0.5F * (o.area() + box.area() - overlap)) others.push_back(o);
+  }
+  // A patch that shows another person says nothing about the surface behind this one.
+  auto on_other_person = [&](const Patch& p) {
+    return std::any_of(others.begin(), others.end(), [&](const cv::Rect2f& o) {
+      return p.u >= o.x && p.u < o.x + o.width && p.v >= o.y && p.v < o.y + o.height;
+    });
+  };
   const Patch torso = patch(depth_image_raw, depth_factor, box, 0.35, 0.2, 0.65, 0.55);
   if (torso.depth_m <= 0) return test;
   test.torso_m = torso.depth_m;
@@ -98,9 +109,15 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
     return 1.0 / inverse;
   };
   std::vector<const Patch*> by_side[3];
+  bool beside_people = false;  // some patch outside the box shows another person
   for (int s = 0; s < 3; ++s) {
     for (const Patch& p : sides[s]) {
-      if (p.depth_m > 0) by_side[s].push_back(&p);
+      if (p.depth_m <= 0) continue;
+      if (on_other_person(p)) {
+        beside_people = true;
+      } else {
+        by_side[s].push_back(&p);
+      }
     }
   }
   const int combinations[4][3] = {{0, 1, 2}, {0, 1, -1}, {0, 2, -1}, {1, 2, -1}};
@@ -124,7 +141,8 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
   const auto near = static_cast<float>(kMinStripPx);
   const bool at_side_edge =
       box.x < near || box.x + box.width > static_cast<float>(depth_image_raw.cols) - near;
-  if (!decided && at_side_edge) {
+  // (Not beside other people: the strips inside a box among people show people too.)
+  if (!decided && at_side_edge && !beside_people) {
     // The box reaches the image's left or right edge and fewer than two sides outside it have depth (a
     // false positive filling the image's width): strips just inside its left and right edges
     // stand in for them. Beside a standing person those strips are mostly background (the box spans the

@@ -12,6 +12,12 @@
 // person, one side as close as they are, still stands out against the pair of the other sides.)
 // Undecidable (kUnknown) without depth, or with patches on fewer than two sides of the box (a box that
 // fills the image's width); those boxes are kept as they are.
+// In a crowd the patches beside a person often show other people, as close as they are: a patch whose
+// centre lies in another person's box (`other_people`; boxes overlapping `box` by IoU >= 0.5 are the
+// same detection and ignored) is not used, so a person among people is judged on the background they
+// stand in front of, or left undecided, never judged flat on their neighbours (nor, at the image's edge,
+// on the strips inside their own box, which among people show people). Without this, every box
+// of a crowd covering the view was flat and the filter removed nothing (docs/CROWDS.md).
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -35,7 +41,7 @@ struct BoxDepthTest {
 
 // depth_image_raw: CV_16UC1, metres = value / depth_factor, 0 = no measurement.
 BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
-                            double margin_m);
+                            double margin_m, const std::vector<cv::Rect2f>& other_people = {});
 
 // Whether a raw (before-NMS) box is flat given its own verdict (`own`) and the NMS boxes with theirs: it
 // is flat when it is found flat itself or when the NMS box it overlaps most, the detection it

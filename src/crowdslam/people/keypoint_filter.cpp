@@ -24,6 +24,31 @@ void KeypointFilterOptions::check() const {
   }
 }
 
+namespace {
+
+// Whether the core of the keypoint's patch (the middle half of its ORB neighbourhood, keypoint.size
+// across) shows the person: a depth within `margin_m` of `person_m`. Such a keypoint is behind the person at
+// its centre but on their silhouette, and its descriptor moves with them. Sampled on a 2-pixel grid.
+bool patch_reaches(const cv::Mat& depth_image_raw, double depth_factor, const cv::KeyPoint& k, double person_m,
+                   double margin_m) {
+  if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1) return false;
+  const int radius = std::max(2, static_cast<int>(std::lround(0.25 * k.size)));
+  const cv::Rect region = cv::Rect(cvRound(k.pt.x) - radius, cvRound(k.pt.y) - radius, 2 * radius + 1,
+                                   2 * radius + 1) &
+                          cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
+  const double low = (person_m - margin_m) * depth_factor;
+  const double high = (person_m + margin_m) * depth_factor;
+  for (int y = region.y; y < region.y + region.height; y += 2) {
+    const auto* row = depth_image_raw.ptr<uint16_t>(y);
+    for (int x = region.x; x < region.x + region.width; x += 2) {
+      if (row[x] > 0 && row[x] >= low && row[x] <= high) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box) {
   if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1) return -1.0;
   // Central region: half the width, 70% of the height.
@@ -74,8 +99,11 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
       if (p.x < r.x || p.y < r.y || p.x >= r.x + r.width || p.y >= r.y + r.height) continue;
       if (use_depth) {
         const double person = result.person_depth_m[b];
-        // Clearly behind the person: background seen past them, keep (it may still be in another box).
-        if (person > 0 && depth_m[i] > person + options.depth_margin_m) continue;
+        // Clearly behind the person, all over its patch: background seen past them, keep (it may still be
+        // in another box). A patch that reaches the person is on their silhouette: dropped.
+        if (person > 0 && depth_m[i] > person + options.depth_margin_m &&
+            !(options.silhouettes && patch_reaches(depth_image_raw, depth_factor, keypoints[i], person, options.depth_margin_m)))
+          continue;
       }
       result.keep[i] = false;
       result.box[i] = origin[b];

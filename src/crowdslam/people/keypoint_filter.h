@@ -5,7 +5,9 @@
 // directly (no per-pixel mask), so the cost is keypoints x boxes, independent of the image size.
 // Depth mode (our extension, RGB-D/stereo): inside a box, only keypoints at the person's depth (or without
 // depth) are dropped; background clearly behind the person (by more than `depth_margin_m`) is kept.
-// The person's depth is a robust estimate from the depth values in the box's central region.
+// The person's depth is a robust estimate from the depth values in the box's central region. A keypoint
+// whose patch (keypoint.size across) reaches the person's depth anywhere is on their silhouette and is
+// dropped too: its descriptor sees the person's edge and moves with them.
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -22,6 +24,7 @@ struct KeypointFilterOptions {
   FilterMode mode = FilterMode::kPaper;
   double margin_px = 5.0;       // boxes grown by this on every side
   double depth_margin_m = 1.0;  // depth mode: keep keypoints this much behind the person
+  bool silhouettes = false;     // depth mode: drop kept keypoints whose patch core shows the person
   void check() const;
 };
 

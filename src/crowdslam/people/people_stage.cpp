@@ -73,6 +73,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   filter_options_.mode = parse_filter_mode(settings.people_filter.mode, "PeopleFilter.mode");
   filter_options_.margin_px = settings.people_filter.margin_px;
   filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
+  filter_options_.silhouettes = settings.people_filter.silhouettes;
   filter_options_.check();
   right_image_boxes_ = settings.people_filter.right_image == "boxes";
   flat_box_margin_m_ = settings.people_filter.flat_box_margin_m;
@@ -350,12 +351,14 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     const double min_area = kFlatTestMinArea * depth_image.cols * depth_image.rows;
     // The NMS boxes are among the raw boxes too: each box is tested once.
     std::vector<std::pair<cv::Rect2f, BoxDepthVerdict>> tested;
+    std::vector<cv::Rect2f> people;  // the NMS boxes: the patches beside a box that show people are not used
+    for (const auto& b : area_boxes) people.push_back(b.box);
     auto verdict = [&](const PersonBox& b) {
       if (b.box.area() < min_area) return BoxDepthVerdict::kUnknown;
       for (const auto& [box, v] : tested) {
         if (box == b.box) return v;
       }
-      const auto v = box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_).verdict;
+      const auto v = box_depth_test(depth_image, depth_factor, b.box, flat_box_margin_m_, people).verdict;
       tested.emplace_back(b.box, v);
       return v;
     };

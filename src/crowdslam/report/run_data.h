@@ -34,7 +34,7 @@ struct FrameSeries {
   std::vector<double> people_area;  // fraction of the image
   std::vector<double> person_boxes;
   std::vector<double> tracked_points;
-  std::vector<std::string> state;   // "ok", "lost", "not_initialized"
+  std::vector<std::string> state;   // "ok", "lost", "bridged", "not_initialized"
   std::vector<std::string> method;  // "init", "motion", "reference", "relocalization", "lost", ""
   std::vector<bool> keyframe;
   [[nodiscard]] size_t size() const { return index.size(); }

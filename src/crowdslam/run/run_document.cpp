@@ -11,18 +11,16 @@
 
 #include "crowdslam/eval/ate.h"
 #include "crowdslam/eval/rpe.h"
+#include "crowdslam/run/bridge_accuracy.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 #include "crowdslam/util/version.h"
 
 namespace crowdslam::run {
 
-namespace {
 nlohmann::json optional_json(const std::optional<double>& value) {
   return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
 }
-
-}  // namespace
 
 std::string dataset_path(const std::string& spec) {
   std::error_code ec;
@@ -113,6 +111,7 @@ void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummar
   for (const auto& r : reports) {
     if (!summary.init_frame && r.method == std::string("init")) summary.init_frame = r.index;
     summary.frames_localized_before_init += r.localized_before_init.size();
+    if (r.state == tracking::TrackingState::kBridged) ++summary.bridged;
     tracking_ms.push_back(r.tracking_ms);
     extraction_ms.push_back(r.extraction_ms);
     total_ms.push_back(r.extraction_ms + r.detector_wait_ms + r.tracking_ms);
@@ -153,7 +152,7 @@ nlohmann::json keyframe_ate(const io::Trajectory& ground_truth, const std::strin
 }  // namespace
 
 void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& ground_truth_name,
-                       const std::vector<io::Trajectory>& segments,
+                       const std::vector<io::Trajectory>& segments, const std::vector<io::Trajectory>& bridged,
                        const std::vector<system::MapSegment>& info, const io::Trajectory& keyframes,
                        bool monocular, RunSummary& summary, nlohmann::json& accuracy) {
   accuracy = nullptr;
@@ -188,6 +187,8 @@ void evaluate_accuracy(const io::Trajectory& ground_truth, const std::string& gr
                       {"ate_pairs", ate.matches.size()},
                       {"alignment", eval::to_string(ate_options.alignment)}});
         if (monocular) entry["sim3_scale"] = ate.alignment.scale;
+        if (k < bridged.size() && !bridged[k].empty())
+          entry["bridged"] = bridge_accuracy(ground_truth, trajectory, bridged[k], ate, ate_options.max_difference_s);
         entry.update(
             keyframe_ate(ground_truth, ground_truth_name, trajectory, keyframes, ate_options, result.map_id));
         // Monocular trajectories have an arbitrary scale: RPE at the aligned scale.
@@ -324,6 +325,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
       {"frames", summary.frames},
       {"tracked_frames", summary.tracked},
       {"tracked_percent", summary.tracked_percent},
+      {"bridged_frames", summary.bridged},
       {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
       {"frames_localized_before_init", summary.frames_localized_before_init},
       {"wall_time_s", c.wall_s},

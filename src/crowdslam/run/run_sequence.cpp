@@ -143,6 +143,9 @@ void write_final_outputs(const std::filesystem::path& out, const system::System&
                          io::TrajectoryFormat format, const nlohmann::json& doc) {
   io::write_trajectory((out / "CameraTrajectory.txt").string(), slam.camera_trajectory(), format);
   io::write_trajectory((out / "KeyFrameTrajectory.txt").string(), slam.keyframe_trajectory(), format);
+  // Frames bridged while people hid the view: not tracked, so never in CameraTrajectory.txt.
+  const io::Trajectory bridged = slam.bridged_trajectory();
+  if (!bridged.empty()) io::write_trajectory((out / "BridgedTrajectory.txt").string(), bridged, format);
   write_file_atomic(out / "run.json", doc.dump(1) + "\n");
 }
 
@@ -316,7 +319,7 @@ RunSummary run_sequence(const RunOptions& options) {
   const auto ground_truth_name = p.source->summary().ground_truth_path;
   evaluate_accuracy(p.source->ground_truth(),
                     ground_truth_name.empty() ? "ground truth" : clip_text(ground_truth_name),
-                    slam.camera_trajectory_segments(), summary.segments, slam.keyframe_trajectory(),
+                    slam.camera_trajectory_segments(), slam.bridged_trajectory_segments(), summary.segments, slam.keyframe_trajectory(),
                     p.sensor == io::SensorKind::kMonocular, summary, accuracy);
   const SkippedFrames skipped = prefetcher.skipped();
   nlohmann::json input = monitor.to_json();

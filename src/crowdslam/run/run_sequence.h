@@ -85,6 +85,7 @@ struct RunSummary {
   size_t frames = 0;
   size_t tracked = 0;  // == poses in CameraTrajectory.txt
   double tracked_percent = 0;
+  size_t bridged = 0;  // frames with the motion model's pose while people hid the view (not tracked)
   std::optional<size_t> init_frame;  // index of the first frame that initialised a map
   size_t frames_localized_before_init =
       0;  // monocular: earlier frames the new maps localised (included in tracked)

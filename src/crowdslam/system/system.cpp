@@ -94,6 +94,8 @@ System::System(const io::Settings& settings, const SystemOptions& options)
     tracker_options.min_init_features = 250;
   }
   tracker_options.odometry_bridge_min_inliers = settings.tracking.odometry_bridge_min_inliers;
+  tracker_options.bridge_max_s = settings.tracking.bridge_max_s;
+  tracker_options.bridge_min_people_share = settings.tracking.bridge_min_people_share;
   const io::GeometrySettings& g = settings.geometry;
   tracker_options.dynamic.enabled = g.dynamic_check;
   tracker_options.dynamic.moving_factor = g.moving_factor;
@@ -319,7 +321,11 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
       return built;
     };
   }
-  const tracking::TrackResult result = tracker_->track(std::move(frame), box_keypoints);
+  const double people_share =
+      report.keypoints_before_filter > 0
+          ? 1.0 - static_cast<double>(report.keypoints) / static_cast<double>(report.keypoints_before_filter)
+          : 0.0;
+  const tracking::TrackResult result = tracker_->track(std::move(frame), box_keypoints, people_share);
   if (options_.sequential) {
     mapper_->process_all();
     if (loop_closer_) loop_closer_->process_all();
@@ -351,6 +357,13 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     record.world_from_cam = result.cam_from_world->inverse();
     record.tracked = true;
     world_from_cam = record.world_from_cam;
+  } else if (result.state == tracking::TrackingState::kBridged && result.bridged_cam_from_world &&
+             result.reference_keyframe) {
+    // Not tracked: the motion model's pose while people hide the view (bridged_trajectory()).
+    record.reference = result.reference_keyframe;
+    record.cam_from_reference = *result.bridged_cam_from_world * result.reference_keyframe->world_from_cam();
+    record.world_from_cam = result.bridged_cam_from_world->inverse();
+    record.bridged = true;
   }
   if (segments_.empty()) segments_.push_back(MapSegment{0, report.index, report.index, 0, 0, 0, 0, 0});
   MapSegment& segment = segments_.back();
@@ -457,6 +470,22 @@ io::Trajectory System::camera_trajectory() const {
     if (r.tracked) trajectory.push_back({r.timestamp_s, world_from_cam(r)});
   }
   return trajectory;
+}
+
+io::Trajectory System::bridged_trajectory() const {
+  io::Trajectory trajectory;
+  for (const auto& r : records_) {
+    if (r.bridged) trajectory.push_back({r.timestamp_s, world_from_cam(r)});
+  }
+  return trajectory;
+}
+
+std::vector<io::Trajectory> System::bridged_trajectory_segments() const {
+  std::vector<io::Trajectory> trajectories(std::max<size_t>(1, segments_.size()));
+  for (const auto& r : records_) {
+    if (r.bridged) trajectories[static_cast<size_t>(r.segment)].push_back({r.timestamp_s, world_from_cam(r)});
+  }
+  return trajectories;
 }
 
 size_t System::tracked_frames() const {

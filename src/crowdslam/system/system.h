@@ -154,6 +154,10 @@ class System {
   // of maps that were reset are those their map had when it ended (each segment has its own frame).
   // Lost frames are left out; every frame counted as tracked has a pose here.
   [[nodiscard]] io::Trajectory camera_trajectory() const;
+  // The frames bridged while people hid the view (TrackerOptions::bridge_max_s): the motion model's poses,
+  // through their reference keyframe like tracked ones. Not tracked, so not in camera_trajectory().
+  [[nodiscard]] io::Trajectory bridged_trajectory() const;
+  [[nodiscard]] std::vector<io::Trajectory> bridged_trajectory_segments() const;  // per map segment
   // The same, one trajectory per map segment (segments().size() entries, in order).
   [[nodiscard]] std::vector<io::Trajectory> camera_trajectory_segments() const;
   // Keyframes of every map segment (earlier maps as they were when reset), in segment order.
@@ -189,6 +193,7 @@ class System {
     geometry::SE3 cam_from_reference;
     geometry::SE3 world_from_cam;  // at tracking time; after a reset, the map's final pose
     bool tracked = false;
+    bool bridged = false;  // state kBridged: a pose, but not a tracked one
   };
   void reset_map();
   // Takes a MapSnapshot for the observers that want one when their interval has passed (or `force`).

@@ -27,6 +27,8 @@ const char* to_string(TrackingState state) {
       return "ok";
     case TrackingState::kLost:
       return "lost";
+    case TrackingState::kBridged:
+      return "bridged";
   }
   return "?";
 }
@@ -40,6 +42,9 @@ void TrackerOptions::check() const {
     throw InputError("tracker: keyframe_reference_min_observations must be >= 1");
   if (keyframe_reference_min_found < 0)
     throw InputError("tracker: keyframe_reference_min_found must be >= 0");
+  if (!(bridge_max_s >= 0)) throw InputError("tracker: bridge_max_s must be >= 0");
+  if (!(bridge_min_people_share >= 0 && bridge_min_people_share <= 1))
+    throw InputError("tracker: bridge_min_people_share must be in [0, 1]");
   pose.check();
   dynamic.check();
   if (monocular) monocular_init.check();
@@ -57,6 +62,9 @@ Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, K
 void Tracker::reset() {
   lost_frames_ = 0;
   last_tracked_s_.reset();
+  last_bridged_s_.reset();
+  bridge_motion_.reset();
+  recent_poses_.clear();
   next_frame_wait_ = NextFrameWait::kNone;
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
@@ -84,9 +92,10 @@ void Tracker::start_in_loaded_map(bool localization_only) {
   localization_only_ = localization_only;
 }
 
-TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
+TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double people_share) {
   TrackResult result;
   result.keypoints = static_cast<int>(frame.size());
+  result.people_share = people_share;
   if (next_frame_wait_ != NextFrameWait::kNone) {
     // The last frame made a keyframe: this frame is tracked once that keyframe's points exist, as in
     // sequential mode; otherwise it sees only the points of the keyframe before, one step late (in a
@@ -104,6 +113,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
   }
   std::unique_lock map_lock(map_->update_mutex());
 
+  bool resumed = false;  // mapping went on from a bridged pose: tracking continues, the frame is reported bridged
   if (state_ == TrackingState::kNotInitialized) {
     if (options_.monocular ? initialize_monocular(frame) : initialize(frame)) {
       state_ = TrackingState::kOk;
@@ -115,6 +125,11 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
   } else {
     bool ok = false;
     const bool was_tracking = state_ == TrackingState::kOk && velocity_ && last_frame_;
+    // After bridged frames the last frame's pose is the motion model's: no motion model or odometry from it
+    // (velocity_ is empty), but the reference keyframe is searched from that pose.
+    const bool after_bridge = state_ == TrackingState::kBridged;
+    // The motion a bridge follows, fixed when it starts.
+    const std::optional<BridgeMotion> motion = after_bridge ? bridge_motion_ : bridge_motion(frame);
     if (last_frame_) replace_replaced_points(*last_frame_);
     bool bridged = false;
     odometry_bridge_.reset();
@@ -128,16 +143,27 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       result.method = "motion";
       by_motion_model = ok;
     }
-    if (!ok && state_ == TrackingState::kOk) {
+    if (!ok && (state_ == TrackingState::kOk || after_bridge)) {
       ok = track_reference_keyframe(frame);
       result.method = "reference";
+    }
+    bool in_local_map = false;
+    if (!ok && after_bridge && bridge(frame, motion)) {
+      // The local map of before the bridge, searched where the motion model puts the frame.
+      map::Frame guess = frame;
+      guess.reference_keyframe = reference_keyframe_;
+      if (track_local_map(guess)) {
+        frame = std::move(guess);
+        ok = in_local_map = true;
+        result.method = "motion";
+      }
     }
     if (!ok) {
       ok = relocalize(frame);
       result.method = "relocalization";
     }
     frame.reference_keyframe = reference_keyframe_;
-    if (ok) ok = track_local_map(frame);
+    if (ok && !in_local_map) ok = track_local_map(frame);
     if (!ok && by_motion_model && fresh) {
       // The motion model found matches but too few of the local map agree with its pose: on a turn that
       // speeds up or slows down, the matches in its search windows can hold a wrong pose. The reference
@@ -197,8 +223,17 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
         result.rescued_with_boxes = true;
       }
     }
-    state_ = ok ? TrackingState::kOk : TrackingState::kLost;
-    if (!ok) result.method = "lost";
+    // People hide the view (bridge), or it has cleared after a bridge onto what the map does not hold: with
+    // depth, mapping goes on from the motion model's pose (the frame is a keyframe, still reported bridged).
+    const bool hidden = people_share >= options_.bridge_min_people_share;
+    const bool resumes = !ok && !hidden && after_bridge && !options_.monocular && !localization_only_;
+    const bool occluded = !ok && (hidden || resumes) && (was_tracking || after_bridge) && bridge(frame, motion);
+    if (occluded && resumes) {
+      ok = bridged = resumed = true;  // a keyframe below
+      result.method = "bridged";
+    }
+    state_ = ok ? TrackingState::kOk : occluded ? TrackingState::kBridged : TrackingState::kLost;
+    if (!ok) result.method = occluded ? "bridged" : "lost";
 
     if (ok && dynamic_check_.enabled()) {
       // The pose is final: which of the matches moved (their map points may be culled), and the regions
@@ -218,14 +253,24 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     if (ok) {
       lost_frames_ = 0;
       last_tracked_s_ = frame.timestamp_s;
-      if (last_frame_ && last_frame_->cam_from_world) {
+      last_bridged_s_.reset();
+      bridge_motion_.reset();
+      if (resumes) {
+        velocity_ = geometry::SE3::exp(motion->twist_per_s * (frame.timestamp_s - last_frame_->timestamp_s));
+      } else if (last_frame_ && last_frame_->cam_from_world && !after_bridge) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else if (!options_.monocular) {
-        // Relocalised after lost frames: the next frame is looked for near this pose (no velocity known),
+        // Relocalised after lost or bridged frames: the next frame is looked for near this pose (no velocity known),
         // so the motion model and its depth points can take it.
         velocity_ = geometry::SE3();
       } else {
         velocity_.reset();
+      }
+      if (!resumed) {
+        recent_poses_.push_back({frame.timestamp_s, *frame.cam_from_world, inliers_in_local_map_});
+        while (recent_poses_.size() > 30) recent_poses_.pop_front();
+      } else {
+        recent_poses_.clear();
       }
       // Visual-odometry matches (points created only for the last frame) are not map points.
       for (auto& p : frame.map_points) {
@@ -260,11 +305,21 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
       // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
       frame.discard_outliers();
       if (!frames_to_retry_.empty()) result.recovered_before_init = retry_frames_before_init();
+    } else if (occluded) {
+      // People hide the view: the motion model's pose, and no clock towards a new map.
+      velocity_.reset();
+      bridge_motion_ = motion;
+      last_bridged_s_ = frame.timestamp_s;
+      lost_frames_ = 0;
+      result.bridged_cam_from_world = frame.cam_from_world;
     } else {
       velocity_.reset();
+      bridge_motion_.reset();
+      recent_poses_.clear();
       ++lost_frames_;
       if (!last_tracked_s_) last_tracked_s_ = frame.timestamp_s;  // lost from its first frame (a new map)
-      const double lost_s = std::abs(frame.timestamp_s - *last_tracked_s_);
+      // The clock runs from the last frame with a pose; after a bridge, from when the view cleared.
+      const double lost_s = std::abs(frame.timestamp_s - last_bridged_s_.value_or(*last_tracked_s_));
       if (!map_loaded_ &&
           map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
@@ -279,13 +334,15 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes) {
     }
   }
   if (!frame.reference_keyframe) frame.reference_keyframe = reference_keyframe_;
-  if (frame.cam_from_world && frame.reference_keyframe && state_ == TrackingState::kOk) {
+  if (frame.cam_from_world && frame.reference_keyframe &&
+      (state_ == TrackingState::kOk || state_ == TrackingState::kBridged)) {
     last_cam_from_reference_ = *frame.cam_from_world * frame.reference_keyframe->world_from_cam();
   }
-  result.state = state_;
-  result.cam_from_world = state_ == TrackingState::kOk ? frame.cam_from_world : std::nullopt;
+  result.state = resumed ? TrackingState::kBridged : state_;
+  if (resumed) result.bridged_cam_from_world = frame.cam_from_world;
+  result.cam_from_world = result.state == TrackingState::kOk ? frame.cam_from_world : std::nullopt;
   result.reference_keyframe = frame.reference_keyframe;
-  result.tracked_points = state_ == TrackingState::kOk ? inliers_in_local_map_ : 0;
+  result.tracked_points = result.state == TrackingState::kOk ? inliers_in_local_map_ : 0;
   frame.depth_raw.release();  // the caller's image: not kept beyond this call
   last_frame_ = std::move(frame);
   return result;
@@ -483,7 +540,8 @@ bool Tracker::track_reference_keyframe(map::Frame& frame) {
   return discard_outliers_count_map_points(frame) >= 10;
 }
 
-// Local-map tracking: tracker_local_map.cpp; keyframe decisions and creation: tracker_keyframes.cpp;
+// The occlusion bridge's motion: tracker_bridge.cpp; local-map tracking: tracker_local_map.cpp; keyframe
+// decisions and creation: tracker_keyframes.cpp;
 // monocular parts: tracker_monocular.cpp.
 
 }  // namespace crowdslam::tracking

@@ -24,7 +24,9 @@ class KeyframeDatabase;
 
 namespace crowdslam::tracking {
 
-enum class TrackingState { kNotInitialized, kOk, kLost };
+// kBridged: people hid the view; the frame has the motion model's pose but is not tracked (see
+// TrackerOptions::bridge_max_s).
+enum class TrackingState { kNotInitialized, kOk, kLost, kBridged };
 const char* to_string(TrackingState state);
 
 struct TrackerOptions {
@@ -86,6 +88,18 @@ struct TrackerOptions {
   // is (method "odometry"). People covering the mapped part of the view, or the camera turning to walls
   // the map has not seen, otherwise lose a camera whose motion is well measured (0 = off).
   int odometry_bridge_min_inliers = 50;
+  // Occlusion bridge (docs/CROWDS.md#total-occlusion): a frame that fails while the people filter took at
+  // least `bridge_min_people_share` of its keypoints has too little static evidence to be judged; it gets
+  // the motion model's pose (state "bridged", never counted as tracked), for up to `bridge_max_s` after
+  // the last tracked frame. No new map is started meanwhile; the frames after it are tracked from the
+  // reference keyframe or relocalised into the same map, and the lost clock starts when the view clears
+  // (0 = off: such frames are lost).
+  double bridge_max_s = 3.0;
+  double bridge_min_people_share = 0.5;
+  // The bridge moves on from the last frame tracked with at least this many local-map inliers, at the
+  // mean velocity of such frames over the half second before it: as people close in, the last few frames
+  // are tracked on little and their poses (and the frame-to-frame velocity) are the least trustworthy.
+  int bridge_anchor_min_inliers = 100;
   // Keypoints in person boxes (Tracker::track, BoxKeypoints): taken back for the pose when the filtered
   // frame tracks fewer than box_check_below points or fails, if they match map points seen at least
   // box_min_observations times (a depth observation counts twice) and judged moving at most once in
@@ -116,8 +130,12 @@ struct TrackResult {
   bool map_reset = false;
   int tracked_points = 0;  // inliers after local-map tracking
   int keypoints = 0;
-  // "init", "motion", "reference", "relocalization", "motion+boxes", "odometry", "lost"
+  // "init", "motion", "reference", "relocalization", "motion+boxes", "odometry", "bridged", "lost"
   const char* method = "";
+  // State kBridged: the motion model's pose for the frame (not a tracked pose).
+  std::optional<geometry::SE3> bridged_cam_from_world;
+  // Share of the frame's keypoints the people filter took (0 without boxes).
+  double people_share = 0;
   int box_matches = 0;   // keypoints in person boxes among the tracked points (BoxKeypoints)
   int static_boxes = 0;  // boxes whose keypoints the static map vouched for (released, see box_keypoints.cpp)
   // The filtered frame failed and the keypoints in boxes tracked it (method "motion+boxes").
@@ -156,7 +174,8 @@ class Tracker {
   // tracking, and static background a person box hides still counts; a person who moves does not agree.
   // Nothing in the map is made of keypoints in boxes (Frame::in_box). A frame the box keypoints rescued is
   // reported as method "motion+boxes".
-  TrackResult track(map::Frame frame, const BoxKeypoints& boxes = {});
+  // `people_share`: the share of the frame's keypoints the people filter took (the occlusion bridge).
+  TrackResult track(map::Frame frame, const BoxKeypoints& boxes = {}, double people_share = 0);
 
   // Place recognition for relocalisation (optional; not owned). With it, frames that have a bag of words
   // relocalise against the database's candidates; without it, against recent keyframes (brute force).
@@ -214,6 +233,20 @@ class Tracker {
   void box_flow_evidence(const map::Frame& full, std::vector<int8_t>& flow) const;
   // Relocalisation of a lost frame with its keypoints in boxes back (see track); nullopt when it fails.
   std::optional<map::Frame> relocalize_with_box_keypoints(const map::Frame& frame, const BoxKeypoints& boxes);
+  // The motion bridged frames follow: from the last reliably tracked frame (bridge_anchor_min_inliers) at
+  // the mean velocity of the reliable frames before it; else from the last frame at `velocity`.
+  struct BridgeMotion {
+    double anchor_s = 0;
+    geometry::SE3 anchor;  // cam_from_world
+    geometry::Vec6 twist_per_s = geometry::Vec6::Zero();
+    [[nodiscard]] geometry::SE3 at(double t) const {
+      return geometry::SE3::exp(twist_per_s * (t - anchor_s)) * anchor;
+    }
+  };
+  [[nodiscard]] std::optional<BridgeMotion> bridge_motion(const map::Frame& frame) const;
+  // Whether `frame` can be bridged (TrackerOptions::bridge_max_s): within bridge_max_s of the last tracked
+  // frame, with a motion to follow. Sets the frame's pose from it (no matches) if so.
+  bool bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const;
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
@@ -242,6 +275,14 @@ class Tracker {
   NextFrameWait next_frame_wait_ = NextFrameWait::kNone;
   int lost_frames_ = 0;                   // consecutive lost frames (new_map_after_lost_min_frames)
   std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
+  std::optional<BridgeMotion> bridge_motion_;  // while bridging
+  struct RecentPose {
+    double timestamp_s = 0;
+    geometry::SE3 cam_from_world;
+    int inliers = 0;
+  };
+  std::deque<RecentPose> recent_poses_;  // the last tracked frames (bridge_motion)
+  std::optional<double> last_bridged_s_;          // timestamp of the last bridged frame (the lost clock)
   int inliers_in_local_map_ = 0;
   bool map_loaded_ = false;
   bool localization_only_ = false;

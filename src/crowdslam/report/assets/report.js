@@ -313,7 +313,7 @@
   }
 
   // ---- tracking timeline -----------------------------------------------------------------------
-  var rows = ['not initialised', 'lost', 'relocalisation', 'reference keyframe', 'motion model', 'initialisation',
+  var rows = ['not initialised', 'lost / bridged', 'relocalisation', 'reference keyframe', 'motion model', 'initialisation',
               'keyframe', 'loop closed', 'map reset'];
   function rowOf(state, method) {
     if (method === 'init') return 5;

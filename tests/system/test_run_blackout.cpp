@@ -1,0 +1,108 @@
+// End-to-end: a crowd that covers the whole view for 1.5 s (synth --crowd blackout) with the generator's
+// exact person boxes. The frames without static evidence are bridged by the motion model: reported
+// "bridged", never counted as tracked, written to BridgedTrajectory.txt only, and the run keeps one map.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "crowdslam/io/trajectory.h"
+#include "crowdslam/run/run_sequence.h"
+#include "crowdslam/synth/options.h"
+#include "crowdslam/synth/writer.h"
+#include "test_support.h"
+
+using namespace crowdslam;
+
+namespace {
+struct Blackout {
+  std::filesystem::path dir;
+  int first = -1;  // frames the generator planned the view to be covered (0-based)
+  int last = -1;
+};
+
+Blackout make_blackout(const test::TempDir& tmp) {
+  synth::SynthOptions options;
+  options.frames = 240;
+  options.people = 6;
+  options.seed = 5;
+  options.crowd = synth::CrowdProfile::kBlackout;  // box people (no sprite_dir): the boxes are exact
+  Blackout b;
+  b.dir = tmp / "blackout";
+  synth::write_sequence(options, b.dir);
+  const auto json = nlohmann::json::parse(test::read_text(b.dir / "synth.json"));
+  b.first = json["blackout_frames"][0].get<int>();
+  b.last = json["blackout_frames"][1].get<int>();
+  return b;
+}
+
+run::RunSummary run_on(const Blackout& b, const std::filesystem::path& out, const std::string& extra = "") {
+  run::RunOptions o;
+  o.dataset = b.dir.string();
+  o.out_dir = out.string();
+  o.sequential = true;
+  o.progress = false;
+  o.detections_file = (b.dir / "people_gt.txt").string();
+  if (!extra.empty()) {
+    const auto settings = out.parent_path() / (out.filename().string() + ".yaml");
+    test::write_text(settings, test::read_text(b.dir / "settings.yaml") + extra);
+    o.settings_path = settings.string();
+  }
+  return run::run_sequence(o);
+}
+}  // namespace
+
+TEST(RunBlackout, BridgedFramesKeepOneMapAndAreNeverCountedAsTracked) {
+  test::TempDir tmp;
+  const Blackout b = make_blackout(tmp);
+  ASSERT_GE(b.first, 0);
+  ASSERT_GT(b.last, b.first + 20);
+  const auto summary = run_on(b, tmp / "out");
+  const auto& doc = summary.json;
+  EXPECT_EQ(doc["summary"]["map_resets"].get<int>(), 0);
+  EXPECT_EQ(doc["segments"].size(), 1u);
+
+  // Per frame: bridged frames are marked, have no tracked points, and lie around the blackout.
+  int bridged = 0, tracked = 0;
+  std::set<double> bridged_stamps;
+  for (const auto& f : doc["frames"]) {
+    const std::string state = f["state"];
+    if (state == "ok") ++tracked;
+    if (state != "bridged") continue;
+    ++bridged;
+    bridged_stamps.insert(f["timestamp"].get<double>());
+    EXPECT_EQ(f["method"], "bridged") << "frame " << f["index"];
+    EXPECT_EQ(f["tracked_points"].get<int>(), 0) << "frame " << f["index"];
+    const int index = f["index"].get<int>();
+    EXPECT_GE(index, b.first - 15) << "bridged long before the crowd covered the view";
+    EXPECT_LE(index, b.last + 15) << "bridged long after the view cleared";
+  }
+  // Most of the covered frames are bridged (a few at its edges may still track or be lost).
+  EXPECT_GE(bridged, (b.last - b.first + 1) * 2 / 3);
+  EXPECT_EQ(doc["summary"]["bridged_frames"].get<int>(), bridged);
+  EXPECT_EQ(summary.bridged, static_cast<size_t>(bridged));
+  EXPECT_EQ(static_cast<int>(summary.tracked), tracked);
+  EXPECT_LE(summary.tracked + summary.bridged, summary.frames);
+
+  // CameraTrajectory.txt holds the tracked frames only; BridgedTrajectory.txt the bridged ones.
+  const auto camera = io::read_tum_trajectory((tmp / "out" / "CameraTrajectory.txt").string());
+  const auto bridged_poses = io::read_tum_trajectory((tmp / "out" / "BridgedTrajectory.txt").string());
+  EXPECT_EQ(camera.size(), summary.tracked);
+  ASSERT_EQ(bridged_poses.size(), static_cast<size_t>(bridged));
+  for (const auto& pose : camera) {
+    for (const double s : bridged_stamps) EXPECT_GT(std::abs(pose.timestamp_s - s), 1e-4);
+  }
+  // The drift of the bridge is reported against the ground truth.
+  const auto& report = doc["accuracy"]["bridged"];
+  ASSERT_TRUE(report.is_object());
+  EXPECT_EQ(report["frames"].get<int>(), bridged);
+  EXPECT_GE(report["bridges"].get<int>(), 1);
+  EXPECT_GT(report["error_max_m"].get<double>(), 0.0);
+  EXPECT_LT(report["error_max_m"].get<double>(), 1.0);  // a 1.5 s bridge at walking speed
+
+  // Without the bridge the covered frames are lost, and after a second a new map starts.
+  const auto without = run_on(b, tmp / "without", "\nTracking.bridge_max_s: 0\n");
+  EXPECT_EQ(without.bridged, 0u);
+  EXPECT_GE(without.json["summary"]["map_resets"].get<int>(), 1);
+}
