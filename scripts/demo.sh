@@ -14,8 +14,8 @@ if [[ ! -f "$seq/groundtruth.txt" ]]; then
   "$bin" synth --out "$seq" --frames 300 --people 3 --seed 1 --force
 fi
 "$bin" dataset info "$seq"
-# The synthetic "people" are textured boxes that a person detector trained on photographs does not
-# recognise, so the demo filters them with the generator's exact boxes (the MOT-file detector backend).
-# On real data the Yolo-Fastest detector runs instead, e.g.:
+# The demo filters the people with the generator's exact boxes (the MOT-file detector backend), so its
+# ATE does not depend on the detector. Without --detections the default person detector (Yolo-Fastest)
+# runs on the rendered people, as it does on real data, e.g.:
 #   build/apps/crowdslam/crowdslam run --dataset ../shared/data/bonn_crowd --settings config/Bonn.yaml --out out/bonn
 "$bin" run --dataset "$seq" --out "$out/run" --overwrite --detections "$seq/people_gt.txt"

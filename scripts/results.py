@@ -26,7 +26,7 @@ DATA = "../shared/data"  # as written in the commands shown to readers
 BONN = [f"--dataset", f"{DATA}/bonn_crowd", "--settings", "config/Bonn.yaml"]
 KITTI = ["--dataset", f"{DATA}/kitti07_head", "--settings", "config/KITTI04-12.yaml", "--sensor", "mono",
          "--no-people-filter", "--allow-untracked"]
-SYNTH_CROWD = ["--frames", "300", "--people", "3", "--seed", "1"]
+SYNTH_CROWD = ["--frames", "300", "--people", "3", "--seed", "1", "--sprites", "none"]  # the box people
 SYNTH_ROOM = ["--frames", "300"]
 
 # name, sequence, setting, run arguments, synthetic sequence (synth arguments) or None
