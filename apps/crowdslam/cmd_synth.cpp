@@ -33,6 +33,9 @@ void add_synth_command(CLI::App& app, GlobalOptions& global) {
                   "with the moving pixels of each frame")
       ->capture_default_str();
   cmd->add_flag("--stereo", args->options.stereo, "Rectified stereo pair, KITTI layout, instead of RGB-D");
+  cmd->add_flag("--hide-people", args->options.hide_people,
+                "Render the same sequence (room, camera, the people's paths) without the people: the empty-room "
+                "baseline of a crowd");
   cmd->add_option("--trajectory", args->trajectory, "Camera path: loop, line, sweep or handheld")
       ->capture_default_str();
   cmd->add_option("--width", args->options.width, "Image width in pixels")->capture_default_str();

@@ -197,3 +197,32 @@ TEST(SynthCrowd, TheBlackoutGroupCoversTheViewOnceForOneAndAHalfSeconds) {
 
 }  // namespace
 }  // namespace crowdslam::synth
+
+namespace crowdslam::synth {
+namespace {
+
+TEST(SynthCrowd, HiddenPeopleLeaveTheSameRoomAndCameraWithoutAnyPerson) {
+  SynthOptions shown = crowd_options(CrowdProfile::kPassing, 16, 30);
+  SynthOptions hidden = shown;
+  hidden.hide_people = true;
+  const Scene a = Scene::build(shown);
+  const Scene b = Scene::build(hidden);
+  EXPECT_EQ(a.options().room_scale(), b.options().room_scale());  // the crowd's room, not the empty one's
+  ASSERT_EQ(a.static_boxes().size(), b.static_boxes().size());
+  EXPECT_NEAR((a.static_boxes()[0].half - b.static_boxes()[0].half).norm(), 0.0, 1e-12);
+  ASSERT_EQ(a.trajectory().size(), b.trajectory().size());
+  for (size_t f = 0; f < a.trajectory().size(); ++f) {
+    EXPECT_NEAR((a.trajectory()[f].world_from_cam.translation() - b.trajectory()[f].world_from_cam.translation()).norm(),
+                0.0, 1e-12);
+  }
+  size_t shown_people = 0;
+  for (int f = 0; f < 30; ++f) {
+    shown_people += a.moving_boxes(f).size() + a.people_billboards(f).size();
+    EXPECT_TRUE(b.moving_boxes(f).empty());
+    EXPECT_TRUE(b.people_billboards(f).empty());
+  }
+  EXPECT_GE(shown_people, 16u * 30u);  // box people or billboards, one per person and frame
+}
+
+}  // namespace
+}  // namespace crowdslam::synth

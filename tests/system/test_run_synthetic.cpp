@@ -155,7 +155,14 @@ TEST(RunSynthetic, StereoCrowdTracksOnWhenPeopleHideWhatTheMapHolds) {
   }
   EXPECT_GE(odometry_frames, 1);
 
-  const auto without = run("without", "\nTracking.odometry_bridge_min_inliers: 0\n");
+  // Without either bridge the camera is lost there, and a new map starts.
+  const auto without = run("without", "\nTracking.odometry_bridge_min_inliers: 0\nTracking.bridge_max_s: 0\n");
   EXPECT_LT(without.tracked_percent, 95.0);
   EXPECT_GE(without.json["segments"].size(), 2u);
+  // The occlusion bridge alone (people took most of those frames' keypoints) keeps the one map too: the
+  // frames it bridges are not tracked, and tracking takes up again in the same map.
+  const auto occlusion_only = run("occlusion", "\nTracking.odometry_bridge_min_inliers: 0\n");
+  EXPECT_EQ(occlusion_only.json["segments"].size(), 1u);
+  EXPECT_GE(occlusion_only.bridged, 1u);
+  EXPECT_LE(occlusion_only.tracked + occlusion_only.bridged, occlusion_only.frames);
 }

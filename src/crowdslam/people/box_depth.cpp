@@ -108,35 +108,50 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
     if (!(inverse > 1e-6)) return std::nullopt;
     return 1.0 / inverse;
   };
-  std::vector<const Patch*> by_side[3];
-  bool beside_people = false;  // some patch outside the box shows another person
+  // The patches by side: all of them, and those that do not show another person beside this one.
+  std::vector<const Patch*> all[3];
+  std::vector<const Patch*> clear[3];
+  bool beside_people = false;  // some patch outside the box shows another person at this one's depth
   for (int s = 0; s < 3; ++s) {
     for (const Patch& p : sides[s]) {
       if (p.depth_m <= 0) continue;
-      if (on_other_person(p)) {
+      all[s].push_back(&p);
+      // Another person behind this one still shows that this one stands out; one beside them at their
+      // depth (or in front) says nothing about the surface behind them.
+      if (on_other_person(p) && p.depth_m <= torso.depth_m + margin_m) {
         beside_people = true;
       } else {
-        by_side[s].push_back(&p);
+        clear[s].push_back(&p);
       }
     }
   }
-  const int combinations[4][3] = {{0, 1, 2}, {0, 1, -1}, {0, 2, -1}, {1, 2, -1}};
-  bool decided = false;
-  for (const auto& combination : combinations) {
-    std::vector<const Patch*> around;
-    int sides_used = 0;
-    for (const int s : combination) {
-      if (s < 0 || by_side[s].empty()) continue;
-      around.insert(around.end(), by_side[s].begin(), by_side[s].end());
-      ++sides_used;
+  // The surface the torso stands out of most, over the planes through pairs of sides and all three.
+  auto deepest_surface = [&](const std::vector<const Patch*> (&by_side)[3]) -> std::optional<double> {
+    const int combinations[4][3] = {{0, 1, 2}, {0, 1, -1}, {0, 2, -1}, {1, 2, -1}};
+    std::optional<double> deepest;
+    for (const auto& combination : combinations) {
+      std::vector<const Patch*> around;
+      int sides_used = 0;
+      for (const int s : combination) {
+        if (s < 0 || by_side[s].empty()) continue;
+        around.insert(around.end(), by_side[s].begin(), by_side[s].end());
+        ++sides_used;
+      }
+      if (sides_used < 2) continue;
+      const auto surface = gap_from(around);
+      if (surface && (!deepest || *surface > *deepest)) deepest = *surface;
     }
-    if (sides_used < 2) continue;
-    const auto surface = gap_from(around);
-    if (!surface) continue;
-    // Reported: the surface the torso stands out of most.
-    if (!decided || *surface > test.surface_m) test.surface_m = *surface;
-    decided = true;
+    return deepest;
+  };
+  std::optional<double> surface = deepest_surface(all);
+  // Flat on every side, people beside it included: flat only if the sides that do not show people say so
+  // too (undecided without them).
+  if (surface && *surface - test.torso_m <= margin_m && beside_people) {
+    surface = deepest_surface(clear);
+    if (!surface) return test;
   }
+  bool decided = surface.has_value();
+  if (surface) test.surface_m = *surface;
   // Near the edge: too little room outside the box for a patch with keypoints in it.
   const auto near = static_cast<float>(kMinStripPx);
   const bool at_side_edge =

@@ -12,10 +12,11 @@
 // person, one side as close as they are, still stands out against the pair of the other sides.)
 // Undecidable (kUnknown) without depth, or with patches on fewer than two sides of the box (a box that
 // fills the image's width); those boxes are kept as they are.
-// In a crowd the patches beside a person often show other people, as close as they are: a patch whose
-// centre lies in another person's box (`other_people`; boxes overlapping `box` by IoU >= 0.5 are the
-// same detection and ignored) is not used, so a person among people is judged on the background they
-// stand in front of, or left undecided, never judged flat on their neighbours (nor, at the image's edge,
+// In a crowd the patches beside a person often show other people, as close as they are. A box found flat
+// with a patch whose centre lies in another person's box (`other_people`; boxes overlapping `box` by
+// IoU >= 0.5 are the same detection and ignored) and that is not behind the torso by more than the
+// margin is judged again without those patches: on the background they stand in front of, or left
+// undecided, never flat on their neighbours alone (nor, at the image's edge,
 // on the strips inside their own box, which among people show people). Without this, every box
 // of a crowd covering the view was flat and the filter removed nothing (docs/CROWDS.md).
 #include <cstdint>

@@ -351,8 +351,13 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
     const double min_area = kFlatTestMinArea * depth_image.cols * depth_image.rows;
     // The NMS boxes are among the raw boxes too: each box is tested once.
     std::vector<std::pair<cv::Rect2f, BoxDepthVerdict>> tested;
-    std::vector<cv::Rect2f> people;  // the NMS boxes: the patches beside a box that show people are not used
-    for (const auto& b : area_boxes) people.push_back(b.box);
+    // RGB-D: the NMS boxes, so that a person is not found flat on the people beside them alone
+    // (box_depth.h). Not in stereo, whose sparse depth around a large false positive over people
+    // showed mostly those people: judged again without them it was undecided and kept, and hid the map.
+    std::vector<cv::Rect2f> people;
+    if (rgbd) {
+      for (const auto& b : area_boxes) people.push_back(b.box);
+    }
     auto verdict = [&](const PersonBox& b) {
       if (b.box.area() < min_area) return BoxDepthVerdict::kUnknown;
       for (const auto& [box, v] : tested) {

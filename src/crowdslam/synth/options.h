@@ -40,6 +40,9 @@ struct SynthOptions {
   // The library never looks for a default; `crowdslam synth` resolves one (resolve_sprite_dir).
   std::string sprite_dir;
   CrowdProfile crowd = CrowdProfile::kAuto;
+  // The same sequence (room, camera path, every person's path) rendered without the people: the empty-room
+  // baseline of a crowd (--hide-people). people_gt.txt is then empty.
+  bool hide_people = false;
 
   // The profile `crowd` stands for: kAuto -> kPassing with sprites, kWalk without.
   CrowdProfile resolved_crowd() const;

@@ -152,7 +152,8 @@ std::vector<Box> Scene::mover_boxes(int frame) const {
 }
 
 std::vector<Box> Scene::moving_boxes(int frame) const {
-  std::vector<Box> boxes = sprites_.empty() ? people_boxes(frame) : std::vector<Box>();
+  std::vector<Box> boxes =
+      sprites_.empty() && !options_.hide_people ? people_boxes(frame) : std::vector<Box>();
   for (Box& b : mover_boxes(frame)) boxes.push_back(std::move(b));
   return boxes;
 }
@@ -218,7 +219,7 @@ void Scene::dress_people_with_sprites() {
 
 std::vector<Billboard> Scene::people_billboards(int frame) const {
   std::vector<Billboard> billboards;
-  if (sprites_.empty()) return billboards;
+  if (sprites_.empty() || options_.hide_people) return billboards;
   const V3 camera = trajectory_.at(frame).world_from_cam.translation();
   for (size_t i = 0; i < people_.size(); ++i) {
     const Sprite& sprite = sprites_[person_sprite_[i]];

@@ -220,6 +220,7 @@ nlohmann::json synth_json(const Scene& scene, const SequenceSummary& summary) {
   j["seed"] = o.seed;
   j["frames"] = o.frames;
   j["people"] = o.people;
+  j["people_hidden"] = o.hide_people;
   j["movers"] = nlohmann::json::array();
   for (const Mover& m : scene.movers()) j["movers"].push_back({{"id", m.id}, {"kind", to_string(m.kind)}});
   if (!scene.movers().empty()) j["moving_mask"] = "mask";  // mask/NNNNNN.png: 255 = a person or a mover

@@ -148,6 +148,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       result.method = "reference";
     }
     bool in_local_map = false;
+    size_t map_points_in_view = 0;  // where the bridge puts the frame
     if (!ok && after_bridge && bridge(frame, motion)) {
       // The local map of before the bridge, searched where the motion model puts the frame.
       map::Frame guess = frame;
@@ -157,6 +158,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
         ok = in_local_map = true;
         result.method = "motion";
       }
+      map_points_in_view = projected_local_points_;
     }
     if (!ok) {
       ok = relocalize(frame);
@@ -226,7 +228,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     // People hide the view (bridge), or it has cleared after a bridge onto what the map does not hold: with
     // depth, mapping goes on from the motion model's pose (the frame is a keyframe, still reported bridged).
     const bool hidden = people_share >= options_.bridge_min_people_share;
-    const bool resumes = !ok && !hidden && after_bridge && !options_.monocular && !localization_only_;
+    const bool resumes = !ok && !hidden && after_bridge && !options_.monocular && !localization_only_ &&
+                         map_points_in_view < static_cast<size_t>(options_.bridge_resume_max_map_points);
     const bool occluded = !ok && (hidden || resumes) && (was_tracking || after_bridge) && bridge(frame, motion);
     if (occluded && resumes) {
       ok = bridged = resumed = true;  // a keyframe below

@@ -100,6 +100,11 @@ struct TrackerOptions {
   // mean velocity of such frames over the half second before it: as people close in, the last few frames
   // are tracked on little and their poses (and the frame-to-frame velocity) are the least trustworthy.
   int bridge_anchor_min_inliers = 100;
+  // With depth, mapping goes on from the bridged pose when the view clears only where the local map holds
+  // fewer than this many points in view (the camera turned while it was covered); where it holds more,
+  // the frame is lost and relocalised instead: the map is there, and a keyframe at a drifted pose would
+  // contradict it.
+  int bridge_resume_max_map_points = 100;
   // Keypoints in person boxes (Tracker::track, BoxKeypoints): taken back for the pose when the filtered
   // frame tracks fewer than box_check_below points or fails, if they match map points seen at least
   // box_min_observations times (a depth observation counts twice) and judged moving at most once in
@@ -284,6 +289,7 @@ class Tracker {
   std::deque<RecentPose> recent_poses_;  // the last tracked frames (bridge_motion)
   std::optional<double> last_bridged_s_;          // timestamp of the last bridged frame (the lost clock)
   int inliers_in_local_map_ = 0;
+  size_t projected_local_points_ = 0;  // local map points in view in the last track_local_map
   bool map_loaded_ = false;
   bool localization_only_ = false;
   std::vector<std::shared_ptr<map::MapPoint>> temporal_points_;  // visual-odometry points of the last frame

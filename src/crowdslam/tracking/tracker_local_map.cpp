@@ -86,6 +86,7 @@ bool Tracker::track_local_map(map::Frame& frame) {
       projected.push_back({p, *projection});
     }
   }
+  projected_local_points_ = projected.size();
   if (!projected.empty()) match::search_local_points(frame, projected, options_.local_map_radius_factor);
 
   optimize_pose(frame);
