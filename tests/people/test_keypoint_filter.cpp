@@ -60,25 +60,26 @@ TEST(KeypointFilter, DepthModeKeepsBackgroundBehindPerson) {
   EXPECT_EQ(filter_keypoints(kps, {person}, options, depth_m).removed, 4);
 }
 
-TEST(KeypointFilter, SilhouettesDropsBackgroundKeypointsWhosePatchShowsThePerson) {
+TEST(KeypointFilter, SilhouettesDropsBackgroundKeypointsOnThePersonsOutline) {
   // The scene above: a person at 2 m (x 60-119, y 40-179) before a background at 5 m.
   cv::Mat depth(200, 200, CV_16UC1, cv::Scalar(5 * 5000));
   depth(cv::Rect(60, 40, 60, 140)).setTo(2 * 5000);
   const PersonBox person = box(50, 30, 80, 160);
-  // Background at their centres; the cores of the second and third patches (size 31: +-8 px) reach the
-  // person's outline, the last does not.
-  const std::vector<cv::KeyPoint> kps{kp(90, 100), kp(55, 100), kp(125, 35), kp(128, 170)};
+  // Background at their centres; the 5 x 5 neighbourhoods of the second (2 px left of the body) and
+  // third (diagonally off its top-right corner) reach the person's outline, the last (6 px right) does not.
+  const std::vector<cv::KeyPoint> kps{kp(90, 100), kp(58, 100), kp(121, 38), kp(126, 170)};
   const std::vector<float> depth_m{2.0f, 5.0f, 5.0f, 5.0f};
   KeypointFilterOptions options;
   options.mode = FilterMode::kDepth;
-  EXPECT_FALSE(options.silhouettes);  // off by default (docs/CROWDS.md: it costs bonn_crowd accuracy)
+  EXPECT_TRUE(options.silhouettes);  // the default
+  EXPECT_EQ(filter_keypoints(kps, {person}, options, depth_m, depth, 5000.0).keep,
+            (std::vector<bool>{false, false, false, true}));
+  options.silhouettes = false;
   EXPECT_EQ(filter_keypoints(kps, {person}, options, depth_m, depth, 5000.0).keep,
             (std::vector<bool>{false, true, true, true}));
   options.silhouettes = true;
-  EXPECT_EQ(filter_keypoints(kps, {person}, options, depth_m, depth, 5000.0).keep,
-            (std::vector<bool>{false, false, false, true}));
-  // Something well in front of the person (0.5 m: beyond the margin) in the patch is not their outline.
-  depth(cv::Rect(130, 160, 20, 20)).setTo(2500);
+  // Something well in front of the person (0.5 m: beyond the margin) beside the keypoint is not their outline.
+  depth(cv::Rect(124, 160, 20, 20)).setTo(2500);
   EXPECT_TRUE(filter_keypoints(kps, {person}, options, depth_m, depth, 5000.0).keep[3]);
 }
 

@@ -81,8 +81,8 @@ struct PeopleFilterSettings {
   double margin_px = 5.0;
   double depth_margin_m =
       1.0;  // "depth" mode: keypoints this far behind the person are kept (measured: 1.0 best)
-  // "depth" mode: a kept keypoint whose patch core shows the person (their silhouette) is dropped too.
-  bool silhouettes = false;
+  // "depth" mode: a kept keypoint whose 5 x 5 neighbourhood shows the person (their outline) is dropped too.
+  bool silhouettes = true;
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the
   // stereo match of a kept left keypoint whose right coordinate falls in a (left-image) person box.
   std::string right_image = "matched";

@@ -26,21 +26,21 @@ void KeypointFilterOptions::check() const {
 
 namespace {
 
-// Whether the core of the keypoint's patch (the middle half of its ORB neighbourhood, keypoint.size
-// across) shows the person: a depth within `margin_m` of `person_m`. Such a keypoint is behind the person at
-// its centre but on their silhouette, and its descriptor moves with them. Sampled on a 2-pixel grid.
-bool patch_reaches(const cv::Mat& depth_image_raw, double depth_factor, const cv::KeyPoint& k, double person_m,
+// Whether the keypoint's 5 x 5 neighbourhood shows the person: a depth within `margin_m` of `person_m`.
+// Such a keypoint is behind the person at its centre pixel but on their outline, and its descriptor sees
+// the person's edge and moves with them.
+bool on_silhouette(const cv::Mat& depth_image_raw, double depth_factor, const cv::KeyPoint& k, double person_m,
                    double margin_m) {
   if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1) return false;
-  const int radius = std::max(2, static_cast<int>(std::lround(0.25 * k.size)));
-  const cv::Rect region = cv::Rect(cvRound(k.pt.x) - radius, cvRound(k.pt.y) - radius, 2 * radius + 1,
-                                   2 * radius + 1) &
+  constexpr int kRadius = 2;
+  const cv::Rect region = cv::Rect(cvRound(k.pt.x) - kRadius, cvRound(k.pt.y) - kRadius, 2 * kRadius + 1,
+                                   2 * kRadius + 1) &
                           cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
   const double low = (person_m - margin_m) * depth_factor;
   const double high = (person_m + margin_m) * depth_factor;
-  for (int y = region.y; y < region.y + region.height; y += 2) {
+  for (int y = region.y; y < region.y + region.height; ++y) {
     const auto* row = depth_image_raw.ptr<uint16_t>(y);
-    for (int x = region.x; x < region.x + region.width; x += 2) {
+    for (int x = region.x; x < region.x + region.width; ++x) {
       if (row[x] > 0 && row[x] >= low && row[x] <= high) return true;
     }
   }
@@ -99,10 +99,10 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
       if (p.x < r.x || p.y < r.y || p.x >= r.x + r.width || p.y >= r.y + r.height) continue;
       if (use_depth) {
         const double person = result.person_depth_m[b];
-        // Clearly behind the person, all over its patch: background seen past them, keep (it may still be
-        // in another box). A patch that reaches the person is on their silhouette: dropped.
+        // Clearly behind the person, and not on their outline: background seen past them, keep (it may
+        // still be in another box).
         if (person > 0 && depth_m[i] > person + options.depth_margin_m &&
-            !(options.silhouettes && patch_reaches(depth_image_raw, depth_factor, keypoints[i], person, options.depth_margin_m)))
+            !(options.silhouettes && on_silhouette(depth_image_raw, depth_factor, keypoints[i], person, options.depth_margin_m)))
           continue;
       }
       result.keep[i] = false;

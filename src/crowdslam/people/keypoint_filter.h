@@ -5,9 +5,9 @@
 // directly (no per-pixel mask), so the cost is keypoints x boxes, independent of the image size.
 // Depth mode (our extension, RGB-D/stereo): inside a box, only keypoints at the person's depth (or without
 // depth) are dropped; background clearly behind the person (by more than `depth_margin_m`) is kept.
-// The person's depth is a robust estimate from the depth values in the box's central region. A keypoint
-// whose patch (keypoint.size across) reaches the person's depth anywhere is on their silhouette and is
-// dropped too: its descriptor sees the person's edge and moves with them.
+// The person's depth is a robust estimate from the depth values in the box's central region. With
+// `silhouettes`, a keypoint whose 5 x 5 neighbourhood shows the person's depth (within the margin) is on
+// their outline and is dropped too: its descriptor sees the person's edge and moves with them.
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -24,7 +24,7 @@ struct KeypointFilterOptions {
   FilterMode mode = FilterMode::kPaper;
   double margin_px = 5.0;       // boxes grown by this on every side
   double depth_margin_m = 1.0;  // depth mode: keep keypoints this much behind the person
-  bool silhouettes = false;     // depth mode: drop kept keypoints whose patch core shows the person
+  bool silhouettes = true;      // depth mode: drop kept keypoints whose 5 x 5 neighbourhood shows the person
   void check() const;
 };
 
