@@ -128,8 +128,14 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     // After bridged frames the last frame's pose is the motion model's: no motion model or odometry from it
     // (velocity_ is empty), but the reference keyframe is searched from that pose.
     const bool after_bridge = state_ == TrackingState::kBridged;
-    // The motion a bridge follows, fixed when it starts.
-    const std::optional<BridgeMotion> motion = after_bridge ? bridge_motion_ : bridge_motion(frame);
+    // The motion a bridge follows, fixed when it starts; worked out only when a frame fails (relocalisation
+    // may reset velocity_ before that, so it is taken now).
+    const std::optional<geometry::SE3> velocity_at_start = velocity_;
+    std::optional<BridgeMotion> motion = bridge_motion_;
+    auto start_motion = [&] {
+      if (!after_bridge) motion = bridge_motion(frame, velocity_at_start);
+      return motion;
+    };
     if (last_frame_) replace_replaced_points(*last_frame_);
     bool bridged = false;
     odometry_bridge_.reset();
@@ -230,7 +236,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     const bool hidden = people_share >= options_.bridge_min_people_share;
     const bool resumes = !ok && !hidden && after_bridge && !options_.monocular && !localization_only_ &&
                          map_points_in_view < static_cast<size_t>(options_.bridge_resume_max_map_points);
-    const bool occluded = !ok && (hidden || resumes) && (was_tracking || after_bridge) && bridge(frame, motion);
+    const bool occluded =
+        !ok && (hidden || resumes) && (was_tracking || after_bridge) && bridge(frame, start_motion());
     if (occluded && resumes) {
       ok = bridged = resumed = true;  // a keyframe below
       result.method = "bridged";

@@ -239,7 +239,8 @@ class Tracker {
   // Relocalisation of a lost frame with its keypoints in boxes back (see track); nullopt when it fails.
   std::optional<map::Frame> relocalize_with_box_keypoints(const map::Frame& frame, const BoxKeypoints& boxes);
   // The motion bridged frames follow: from the last reliably tracked frame (bridge_anchor_min_inliers) at
-  // the mean velocity of the reliable frames before it; else from the last frame at `velocity`.
+  // the mean velocity of the reliable frames before it; else from the last frame at `velocity` (its
+  // velocity when the frame came).
   struct BridgeMotion {
     double anchor_s = 0;
     geometry::SE3 anchor;  // cam_from_world
@@ -248,7 +249,8 @@ class Tracker {
       return geometry::SE3::exp(twist_per_s * (t - anchor_s)) * anchor;
     }
   };
-  [[nodiscard]] std::optional<BridgeMotion> bridge_motion(const map::Frame& frame) const;
+  [[nodiscard]] std::optional<BridgeMotion> bridge_motion(const map::Frame& frame,
+                                                          const std::optional<geometry::SE3>& velocity) const;
   // Whether `frame` can be bridged (TrackerOptions::bridge_max_s): within bridge_max_s of the last tracked
   // frame, with a motion to follow. Sets the frame's pose from it (no matches) if so.
   bool bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const;

@@ -6,7 +6,8 @@
 
 namespace crowdslam::tracking {
 
-std::optional<Tracker::BridgeMotion> Tracker::bridge_motion(const map::Frame& frame) const {
+std::optional<Tracker::BridgeMotion> Tracker::bridge_motion(const map::Frame& frame,
+                                                             const std::optional<geometry::SE3>& velocity) const {
   if (options_.bridge_max_s <= 0) return std::nullopt;
   // The last reliable frame, and the earliest reliable one within half a second before it.
   const RecentPose* anchor = nullptr;
@@ -25,10 +26,10 @@ std::optional<Tracker::BridgeMotion> Tracker::bridge_motion(const map::Frame& fr
                         step.log() / (anchor->timestamp_s - base->timestamp_s)};
   }
   // Not enough reliable frames: on from the last frame at its velocity.
-  if (!velocity_ || !last_frame_ || !last_frame_->cam_from_world) return std::nullopt;
+  if (!velocity || !last_frame_ || !last_frame_->cam_from_world) return std::nullopt;
   const double dt = frame.timestamp_s - last_frame_->timestamp_s;
   if (!(dt > 0)) return std::nullopt;
-  return BridgeMotion{last_frame_->timestamp_s, *last_frame_->cam_from_world, velocity_->log() / dt};
+  return BridgeMotion{last_frame_->timestamp_s, *last_frame_->cam_from_world, velocity->log() / dt};
 }
 
 bool Tracker::bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const {
