@@ -138,6 +138,32 @@ TEST(BoxDepth, ANarrowBoxAtTheLeftEdgeIsJudgedOnStripsWideEnoughToHoldDepth) {
             BoxDepthVerdict::kUnknown);
 }
 
+TEST(BoxDepth, APersonCutByTheImagesEdgeStandsOutOfWhatIsBesideThem) {
+  // A person 0.7 m from the camera, cut by the image's left (or right) edge, fills their box from the
+  // top of the image to the bottom: no side outside the box but one. The strips inside both edges of the
+  // box show the person; the side outside shows the wall 4 m away. Judged on the inner strips alone the
+  // box was flat on the person (their keypoints then reached the map: docs/CROWDS.md).
+  for (const bool left : {true, false}) {
+    SCOPED_TRACE(left ? "left edge" : "right edge");
+    const cv::Rect body = left ? cv::Rect(0, 0, 207, kHeight) : cv::Rect(kWidth - 207, 0, 207, kHeight);
+    const cv::Rect2f box(static_cast<float>(body.x), 0, 207, kHeight);
+    cv::Mat person = plane_image(kFrontal, 4.0);
+    add_slab(person, body, 3.3);
+    const auto close = box_depth_test(person, kFactor, box, 0.2);
+    EXPECT_EQ(close.verdict, BoxDepthVerdict::kStandsOut);
+    EXPECT_NEAR(close.torso_m, 0.7, 1e-3);
+    EXPECT_GT(close.surface_m - close.torso_m, 0.2);
+    // The same box on a wall, frontal or oblique either way: the side outside and the strip at the
+    // image's edge lie on one plane with the box's middle.
+    const double mirrored[3] = {-kOblique[0], kOblique[1], kOblique[2]};
+    for (const double* normal : {kFrontal, kOblique, mirrored}) {
+      const auto wall = box_depth_test(plane_image(normal, 1.5), kFactor, box, 0.2);
+      EXPECT_EQ(wall.verdict, BoxDepthVerdict::kFlat) << "normal x " << normal[0];
+      EXPECT_NEAR(wall.surface_m, wall.torso_m, 0.1 * wall.torso_m) << "normal x " << normal[0];
+    }
+  }
+}
+
 TEST(BoxDepth, NoDepthIsUndecided) {
   const cv::Mat empty;
   EXPECT_EQ(box_depth_test(empty, kFactor, cv::Rect2f(200, 100, 150, 300), 0.2).verdict,

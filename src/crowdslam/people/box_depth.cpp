@@ -33,18 +33,73 @@ Patch patch(const cv::Mat& depth, double factor, const cv::Rect2f& box, double x
   if (region.area() <= 0) return p;
   p.u = region.x + 0.5 * region.width;
   p.v = region.y + 0.5 * region.height;
-  std::vector<uint16_t> values = sample_valid_depths(depth, region, 400);
+  // The patch sits where its depths were measured: with holes in part of the region (stereo near the
+  // image's edge) the median depth belongs to the measured part, not to the region's centre.
+  double sum_u = 0;
+  double sum_v = 0;
+  std::vector<uint16_t> values = sample_valid_depths(depth, region, 400, &sum_u, &sum_v);
   if (values.size() < 10) return p;
+  p.u = sum_u / static_cast<double>(values.size());
+  p.v = sum_v / static_cast<double>(values.size());
   const auto mid = values.begin() + static_cast<long>(values.size() / 2);
   std::nth_element(values.begin(), mid, values.end());
   p.depth_m = *mid / factor;
   return p;
 }
 
+// Along rows through the torso (25-55 % of the box's height), from the box's middle towards one side and
+// a quarter of its width past it: a step in depth between neighbouring measured pixels (at most 4 px
+// apart) from the torso's surface (not behind the torso by more than `margin_m`) to at least `margin_m`
+// and 10 % farther, the far side holding for the next 4 measurements. A surface that continues (a wall, a
+// poster on it, frontal or oblique) changes depth smoothly; a body ends at its outline with the background
+// behind it. The median depth behind the edge when at least two of the four rows show one.
+std::optional<double> occluding_edge(const cv::Mat& depth, double factor, const cv::Rect2f& box, double torso_m,
+                                     double margin_m, bool towards_right) {
+  constexpr int kMaxGapPx = 4;
+  constexpr int kHold = 4;
+  const int from = std::clamp(cvRound(box.x + 0.5 * box.width), 0, depth.cols - 1);
+  const int to = std::clamp(cvRound(towards_right ? box.x + 1.25 * box.width : box.x - 0.25 * box.width), 0,
+                            depth.cols - 1);
+  const int step = towards_right ? 1 : -1;
+  std::vector<double> behind;
+  int rows_with_edge = 0;
+  for (const double at : {0.25, 0.35, 0.45, 0.55}) {
+    const int v = cvRound(box.y + at * box.height);
+    if (v < 0 || v >= depth.rows) continue;
+    const auto* row = depth.ptr<uint16_t>(v);
+    double last = -1.0;
+    int last_u = from;
+    for (int u = from; u != to + step; u += step) {
+      if (row[u] == 0) continue;
+      const double z = row[u] / factor;
+      if (last > 0 && std::abs(u - last_u) <= kMaxGapPx && last <= torso_m + margin_m &&
+          z - last > std::max(margin_m, 0.1 * last)) {
+        // The far side must hold: the next kHold measurements stay behind the near side.
+        int held = 0;
+        for (int w = u + step; w != to + step && held < kHold; w += step) {
+          if (row[w] == 0) continue;
+          if (row[w] / factor - last <= margin_m) break;
+          ++held;
+        }
+        if (held == kHold) {
+          ++rows_with_edge;
+          behind.push_back(z);
+          break;
+        }
+      }
+      last = z;
+      last_u = u;
+    }
+  }
+  if (rows_with_edge < 2) return std::nullopt;
+  std::nth_element(behind.begin(), behind.begin() + static_cast<long>(behind.size() / 2), behind.end());
+  return behind[behind.size() / 2];
+}
+
 }  // namespace
 
 std::vector<uint16_t> sample_valid_depths(const cv::Mat& depth_image_raw, const cv::Rect& region_in,
-                                          int max_samples) {
+                                          int max_samples, double* sum_u, double* sum_v) {
   const cv::Rect region = region_in & cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
   std::vector<uint16_t> values;
   if (region.area() <= 0 || max_samples < 1) return values;
@@ -52,7 +107,10 @@ std::vector<uint16_t> sample_valid_depths(const cv::Mat& depth_image_raw, const 
   for (int y = region.y; y < region.y + region.height; y += step) {
     const auto* row = depth_image_raw.ptr<uint16_t>(y);
     for (int x = region.x; x < region.x + region.width; x += step) {
-      if (row[x] > 0) values.push_back(row[x]);
+      if (row[x] <= 0) continue;
+      values.push_back(row[x]);
+      if (sum_u) *sum_u += x;
+      if (sum_v) *sum_v += y;
     }
   }
   return values;
@@ -92,8 +150,11 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
   // them says so. A wall continuing past the box agrees on every side; a person beside a crate or another
   // person (one side as close as they are) still stands out against the other sides.
   const double scale = 1.0 / std::max(depth_image_raw.cols, depth_image_raw.rows);
-  auto gap_from = [&](const std::vector<const Patch*>& around) -> std::optional<double> {
+  // The depth the plane through `around` predicts at pixel (u, v) (by default the torso's).
+  auto gap_from = [&](const std::vector<const Patch*>& around, std::optional<cv::Point2d> at = std::nullopt)
+      -> std::optional<double> {
     if (around.size() < 3) return std::nullopt;
+    const cv::Point2d where = at.value_or(cv::Point2d(torso.u, torso.v));
     // 1/z = a u + b v + c, least squares over the patches (pixels scaled to ~1 for conditioning).
     Eigen::MatrixXd a(static_cast<Eigen::Index>(around.size()), 3);
     Eigen::VectorXd b(static_cast<Eigen::Index>(around.size()));
@@ -102,9 +163,9 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
       b(static_cast<Eigen::Index>(i)) = 1.0 / around[i]->depth_m;
     }
     const Eigen::Vector3d plane = a.colPivHouseholderQr().solve(b);
-    const double inverse = plane.dot(Eigen::Vector3d(torso.u * scale, torso.v * scale, 1.0));
-    // A plane that does not reach the torso's ray in front of the camera: the surroundings are not one
-    // surface there, nothing to compare with.
+    const double inverse = plane.dot(Eigen::Vector3d(where.x * scale, where.y * scale, 1.0));
+    // A plane that does not reach the ray in front of the camera: the patches are not one surface
+    // there, nothing to compare with.
     if (!(inverse > 1e-6)) return std::nullopt;
     return 1.0 / inverse;
   };
@@ -154,8 +215,9 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
   if (surface) test.surface_m = *surface;
   // Near the edge: too little room outside the box for a patch with keypoints in it.
   const auto near = static_cast<float>(kMinStripPx);
-  const bool at_side_edge =
-      box.x < near || box.x + box.width > static_cast<float>(depth_image_raw.cols) - near;
+  const bool at_left_edge = box.x < near;
+  const bool at_right_edge = box.x + box.width > static_cast<float>(depth_image_raw.cols) - near;
+  const bool at_side_edge = at_left_edge || at_right_edge;
   // (Not beside other people: the strips inside a box among people show people too.)
   if (!decided && at_side_edge && !beside_people) {
     // The box reaches the image's left or right edge and fewer than two sides outside it have depth (a
@@ -198,6 +260,17 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
         test.surface_m = *surface;
         decided = true;
       }
+    }
+  }
+  // At one side edge only (a person close to the camera, cut by the image's edge, fills their box, so the
+  // strips inside both its edges may show only them): an occluding edge beside the torso, towards the side
+  // the box has outside it, shows a body in front of what is behind it.
+  if (at_left_edge != at_right_edge && !beside_people &&
+      (!decided || test.surface_m - test.torso_m <= margin_m)) {
+    if (const auto behind = occluding_edge(depth_image_raw, depth_factor, box, test.torso_m, margin_m,
+                                           /*towards_right=*/at_left_edge)) {
+      test.surface_m = *behind;
+      decided = true;
     }
   }
   if (!decided) return test;

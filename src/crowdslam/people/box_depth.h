@@ -10,8 +10,12 @@
 // one through all three. If the torso is not closer than any of these planes by more than `margin_m`, the
 // box is flat: nothing stands out of the surface it was found on. (A person beside a crate or another
 // person, one side as close as they are, still stands out against the pair of the other sides.)
-// Undecidable (kUnknown) without depth, or with patches on fewer than two sides of the box (a box that
-// fills the image's width); those boxes are kept as they are.
+// A box at the image's left or right edge with fewer than two sides outside it is judged on strips inside
+// both its edges. A close person cut by the image's edge fills their box, so those strips may show only
+// them: a box at one side edge also stands out where rows through its torso meet an occluding edge (a
+// step in depth from the torso's surface to something behind it) towards the side it has outside it.
+// Undecidable (kUnknown) without depth, or with too little depth around the box; those boxes are kept
+// as they are.
 // In a crowd the patches beside a person often show other people, as close as they are. A box found flat
 // with a patch whose centre lies in another person's box (`other_people`; boxes overlapping `box` by
 // IoU >= 0.5 are the same detection and ignored) and that is not behind the torso by more than the
@@ -28,9 +32,10 @@
 namespace crowdslam::people {
 
 // The valid (non-zero) raw depths of `region` (clipped to the image), on a regular grid of about
-// `max_samples` pixels: robust statistics of a region do not need every pixel.
+// `max_samples` pixels: robust statistics of a region do not need every pixel. `sum_u`, `sum_v` (optional)
+// get the sums of the sampled pixels' coordinates added.
 std::vector<uint16_t> sample_valid_depths(const cv::Mat& depth_image_raw, const cv::Rect& region,
-                                          int max_samples);
+                                          int max_samples, double* sum_u = nullptr, double* sum_v = nullptr);
 
 enum class BoxDepthVerdict { kStandsOut, kFlat, kUnknown };
 

@@ -141,6 +141,15 @@ int DynamicCheck::screen(map::Frame& frame, const optim::PoseOptimizerOptions& p
   return screened;
 }
 
+int DynamicCheck::trusted_inliers(const map::Frame& frame) const {
+  int n = 0;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (p && !frame.outliers[i] && !frame.dynamic[i] && !p->is_bad() && trusted_point(*p)) ++n;
+  }
+  return n;
+}
+
 DynamicCheckStats DynamicCheck::update(map::Frame& frame, const map::Frame* last) {
   DynamicCheckStats stats;
   if (!enabled() || !frame.cam_from_world) return stats;

@@ -87,6 +87,8 @@ class DynamicCheck {
   // frame.cam_from_world to the trusted pose and marks the matches that disagree with it dynamic for the
   // optimisation (update() judges them afresh). Returns the number of matches screened out.
   int screen(map::Frame& frame, const optim::PoseOptimizerOptions& pose_options) const;
+  // The frame's matches that are trusted (see screen) and inliers of its pose (not outliers, not dynamic).
+  [[nodiscard]] int trusted_inliers(const map::Frame& frame) const;
 
   // After the frame's pose is final: tests every match, updates the keypoints' histories and the map
   // points' scores, culls map points seen moving repeatedly, and grows regions. `last` may be null.

@@ -495,14 +495,33 @@ int Tracker::optimize_pose(map::Frame& frame) {
   if (dynamic_check_.screen(frame, options_.pose) == 0) return optimize_frame_pose(frame, options_.pose);
   const std::vector<std::shared_ptr<map::MapPoint>> matches = frame.map_points;
   const int inliers = optimize_frame_pose(frame, options_.pose);
-  if (inliers >= 50) return inliers;
-  // Too little agrees with the trusted points' pose (they may be the ones that moved): the ordinary
-  // optimisation from the initial guess decides instead.
+  int usable = 0;  // matches not known to move before the screening
+  for (size_t i = 0; i < matches.size(); ++i) {
+    if (matches[i] && !inherited[i]) ++usable;
+  }
+  if (inliers >= 50 && 2 * inliers >= usable) return inliers;
+  // The trusted points' pose leaves most matches out: they may be movers (people outside the filter's
+  // reach), or the trusted points may be (points on a person that reached the map). The ordinary
+  // optimisation from the initial guess is tried too.
+  const int trusted_screened = dynamic_check_.trusted_inliers(frame);
+  const auto screened_pose = frame.cam_from_world;
+  const std::vector<bool> screened_dynamic = frame.dynamic;
+  const std::vector<bool> screened_outliers = frame.outliers;
   frame.cam_from_world = initial_pose;
   frame.dynamic = inherited;
   frame.map_points = matches;
   std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-  return optimize_frame_pose(frame, options_.pose);
+  const int plain = optimize_frame_pose(frame, options_.pose);
+  const int trusted_plain = dynamic_check_.trusted_inliers(frame);
+  // Too little agrees with the trusted points' pose: the ordinary optimisation decides. Otherwise the
+  // ordinary pose wins only where it holds more matches and keeps nearly as many trusted points (4 in 5):
+  // movers that take it over leave the trusted points (long-seen background) as its outliers, while two
+  // poses a few centimetres apart both keep most of them.
+  if (inliers < 50 || (plain > inliers && 5 * trusted_plain >= 4 * trusted_screened)) return plain;
+  frame.cam_from_world = screened_pose;
+  frame.dynamic = screened_dynamic;
+  frame.outliers = screened_outliers;
+  return inliers;
 }
 
 int Tracker::count_tracked_in_map(const map::Frame& frame) const {
