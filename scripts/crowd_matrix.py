@@ -10,6 +10,7 @@ room's, and frames/s.
 
 Writes OUT/matrix.json (every run's figures) and OUT/matrix.md (the table); sequences are kept in
 OUT/seq/ and reused when they exist. Needs the person sprites (scripts/build_people_sprites.sh).
+CROWDSLAM_CLI names another crowdslam binary (default: build/apps/crowdslam/crowdslam).
 """
 import argparse
 import json
@@ -19,7 +20,7 @@ import subprocess
 import sys
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CLI = os.path.join(REPO, "build", "apps", "crowdslam", "crowdslam")
+CLI = os.environ.get("CROWDSLAM_CLI", os.path.join(REPO, "build", "apps", "crowdslam", "crowdslam"))
 
 
 def synth(out, profile, people, seed, frames, stereo, hidden):
