@@ -79,8 +79,9 @@ struct PeopleFilterSettings {
   bool enabled = true;
   std::string mode = "depth";  // "depth" (default: measured best on bonn_crowd) | "paper"
   double margin_px = 5.0;
-  double depth_margin_m =
-      1.0;  // "depth" mode: keypoints this far behind the person are kept (measured: 1.0 best)
+  // "depth" mode: keypoints this far behind the person are kept. 0.5: bonn_crowd as with 1.0, and in
+  // crowds close to the camera the background 0.5-1 m behind people is kept (docs/CROWDS.md).
+  double depth_margin_m = 0.5;
   // "depth" mode: a kept keypoint whose 5 x 5 neighbourhood shows the person (their outline) is dropped too.
   bool silhouettes = true;
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the

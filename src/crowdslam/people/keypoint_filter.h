@@ -23,7 +23,7 @@ const char* to_string(FilterMode mode);
 struct KeypointFilterOptions {
   FilterMode mode = FilterMode::kPaper;
   double margin_px = 5.0;       // boxes grown by this on every side
-  double depth_margin_m = 1.0;  // depth mode: keep keypoints this much behind the person
+  double depth_margin_m = 0.5;  // depth mode: keep keypoints this much behind the person
   bool silhouettes = true;      // depth mode: drop kept keypoints whose 5 x 5 neighbourhood shows the person
   void check() const;
 };
