@@ -83,6 +83,29 @@ TEST(KeypointFilter, SilhouettesDropsBackgroundKeypointsOnThePersonsOutline) {
   EXPECT_TRUE(filter_keypoints(kps, {person}, options, depth_m, depth, 5000.0).keep[3]);
 }
 
+TEST(KeypointFilter, BackgroundCloseBehindThePersonIsKeptOnlyClearOfTheirOutline) {
+  // A person at 2 m (x 60-119) before a wall 0.7 m behind them: beyond the margin (0.5 m), but within
+  // two margins, so a keypoint there needs the middle of its ORB patch (8 px) clear of the person.
+  cv::Mat depth(200, 200, CV_16UC1, cv::Scalar(static_cast<int>(2.7 * 5000)));
+  depth(cv::Rect(60, 40, 60, 140)).setTo(2 * 5000);
+  const PersonBox person = box(50, 30, 100, 160);
+  KeypointFilterOptions options;
+  options.mode = FilterMode::kDepth;
+  EXPECT_DOUBLE_EQ(options.depth_margin_m, 0.5);  // the default
+  // 6 px right of the body: its patch sees the person's edge; 12 px right: clear of it.
+  const std::vector<cv::KeyPoint> kps{kp(125, 100), kp(131, 100)};
+  EXPECT_EQ(filter_keypoints(kps, {person}, options, {2.7f, 2.7f}, depth, 5000.0).keep,
+            (std::vector<bool>{false, true}));
+  // A wall 1.5 m behind (beyond two margins): only the 5 x 5 neighbourhood has to be clear.
+  depth.setTo(static_cast<int>(3.5 * 5000));
+  depth(cv::Rect(60, 40, 60, 140)).setTo(2 * 5000);
+  EXPECT_EQ(filter_keypoints(kps, {person}, options, {3.5f, 3.5f}, depth, 5000.0).keep,
+            (std::vector<bool>{true, true}));
+  // Within the margin (2.3 m): the person's, dropped wherever it is in the box.
+  EXPECT_EQ(filter_keypoints({kp(140, 100)}, {person}, options, {2.3f}, depth, 5000.0).keep,
+            (std::vector<bool>{false}));
+}
+
 TEST(KeypointFilter, BadModeAndMarginAreInputErrors) {
   EXPECT_THROW(parse_filter_mode("mask", "PeopleFilter.mode"), InputError);
   KeypointFilterOptions options;

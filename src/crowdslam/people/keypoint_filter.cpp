@@ -30,9 +30,8 @@ namespace {
 // Such a keypoint is behind the person at its centre pixel but on their outline, and its descriptor sees
 // the person's edge and moves with them.
 bool on_silhouette(const cv::Mat& depth_image_raw, double depth_factor, const cv::KeyPoint& k, double person_m,
-                   double margin_m) {
+                   double margin_m, int kRadius) {
   if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1) return false;
-  constexpr int kRadius = 2;
   const cv::Rect region = cv::Rect(cvRound(k.pt.x) - kRadius, cvRound(k.pt.y) - kRadius, 2 * kRadius + 1,
                                    2 * kRadius + 1) &
                           cv::Rect(0, 0, depth_image_raw.cols, depth_image_raw.rows);
@@ -101,8 +100,12 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
         const double person = result.person_depth_m[b];
         // Clearly behind the person, and not on their outline: background seen past them, keep (it may
         // still be in another box).
+        // Background close behind the person (within two margins) is kept only clear of their outline
+        // by the middle of the ORB patch (8 px): next to the person it is mostly their edge.
+        const int radius = depth_m[i] > person + 2 * options.depth_margin_m ? 2 : 8;
         if (person > 0 && depth_m[i] > person + options.depth_margin_m &&
-            !(options.silhouettes && on_silhouette(depth_image_raw, depth_factor, keypoints[i], person, options.depth_margin_m)))
+            !(options.silhouettes &&
+              on_silhouette(depth_image_raw, depth_factor, keypoints[i], person, options.depth_margin_m, radius)))
           continue;
       }
       result.keep[i] = false;

@@ -7,7 +7,8 @@
 // depth) are dropped; background clearly behind the person (by more than `depth_margin_m`) is kept.
 // The person's depth is a robust estimate from the depth values in the box's central region. With
 // `silhouettes`, a keypoint whose 5 x 5 neighbourhood shows the person's depth (within the margin) is on
-// their outline and is dropped too: its descriptor sees the person's edge and moves with them.
+// their outline and is dropped too: its descriptor sees the person's edge and moves with them. Background
+// within two margins behind the person needs a 17 x 17 neighbourhood clear of the person instead.
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
