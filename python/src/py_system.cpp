@@ -98,6 +98,14 @@ FrameResult PySystem::track(const py::object& image, const py::object& depth, co
   if (!std::isfinite(timestamp_s)) {
     throw py::value_error("track(): timestamp: expected a finite time in seconds, got " + std::to_string(timestamp_s));
   }
+  if (last_timestamp_s_ && timestamp_s <= *last_timestamp_s_) {
+    // Accepted (frames are taken in the order given), but never silently: motion and pacing assume time
+    // goes forward.
+    const std::string message = "track(): timestamp " + std::to_string(timestamp_s) +
+                                " is not after the previous frame's (" + std::to_string(*last_timestamp_s_) + ")";
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+  }
+  last_timestamp_s_ = timestamp_s;
   const io::SensorKind sensor = args_.options.sensor;
   const std::string sensor_name = io::to_string(sensor);
   py::object keep_image, keep_depth, keep_right;  // own the memory the cv::Mats point into

@@ -85,6 +85,7 @@ class PySystem {
   PoseObserver observer_;
   std::atomic<bool> closed_{false};  // shutdown() was called: track() refuses, the results stay
   std::optional<cv::Size> first_size_;
+  std::optional<double> last_timestamp_s_;  // of the previous track() (a RuntimeWarning when not after it)
 };
 
 // Registers System, FrameResult and the module-level stop_all() on `m`.
