@@ -18,6 +18,17 @@ struct RunArgs {
   size_t frames = 0;
 };
 
+// A count (frames): digits only, so that -1 is an error rather than a huge number.
+CLI::Validator count() {
+  return CLI::Validator(
+      [](std::string& value) {
+        return !value.empty() && value.size() <= 12 && value.find_first_not_of("0123456789") == std::string::npos
+                   ? std::string()
+                   : "expected a whole number >= 0, got '" + value.substr(0, 40) + "'";
+      },
+      "", "COUNT");
+}
+
 CLI::Validator non_empty() {
   return CLI::Validator([](std::string& value) { return value.empty() ? std::string("empty value") : std::string(); },
                         "", "NON-EMPTY");
@@ -83,7 +94,7 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
   cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(count());
   cmd->add_flag(
       "!--no-people-filter", args->options.people_filter,
       "Run without the people filter and without the feature-number update (static-world baseline)");
@@ -114,7 +125,7 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "(Ground.enabled; config/KITTI*.yaml turn it on)");
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/")
-      ->check(CLI::NonNegativeNumber);
+      ->check(count());
   cmd->add_option(
       "--vocabulary", args->options.vocabulary,
       "ORB vocabulary for relocalisation (default: $CROWDSLAM_VOCABULARY or vocabulary/crowdslam_orb.voc); "

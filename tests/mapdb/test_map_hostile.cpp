@@ -74,10 +74,12 @@ std::filesystem::path MapHostile::room_;
 
 // Finding 3: new keyframes and points would take the ids of loaded ones.
 TEST_F(MapHostile, NextIdsNotAboveTheStoredIdsAreCorrupt) {
-  for (const std::string value : {"0", "1", "-1"}) {
+  // 0, -1, and the largest stored id itself (the next keyframe would take it).
+  int n = 0;
+  for (const std::string value : {"'0'", "'-1'", "(SELECT CAST(MAX(id) AS TEXT) FROM keyframes)"}) {
     SCOPED_TRACE(value);
-    const auto path = copy("next_ids" + value + ".db");
-    test::exec_sql(path, "UPDATE metadata SET value = '" + value + "' WHERE key = 'map.next_keyframe_id'");
+    const auto path = copy("next_ids" + std::to_string(n++) + ".db");
+    test::exec_sql(path, "UPDATE metadata SET value = " + value + " WHERE key = 'map.next_keyframe_id'");
     expect_corrupt(path, {"corrupt map", "map.next_keyframe_id"});
   }
   const auto points = copy("next_point_id.db");

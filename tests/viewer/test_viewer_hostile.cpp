@@ -103,7 +103,7 @@ struct LiveServer {
 TEST(ViewerHostile, ClientReportIsParsedAndStateStaysOneValidDocument) {
   LiveServer live;
   const int port = live.server->port();
-  for (const std::string bad : {std::string("{\"x\":1},\"run\":{\"finished\":true,\"frames\":-1},\"zz\":{}"),
+  for (const std::string& bad : {std::string("{\"x\":1},\"run\":{\"finished\":true,\"frames\":-1},\"zz\":{}"),
                                 std::string("not json"), std::string("[1,2]"), std::string("{\"a\":"),
                                 std::string("{}") + std::string(2000, ' ')}) {
     SCOPED_TRACE(bad.substr(0, 60));

@@ -81,7 +81,9 @@ struct Prepared {
 
 Prepared prepare(const RunOptions& options) {
   Prepared p;
-  p.source = io::open_source(options.dataset);
+  io::DatasetOptions dataset_options;
+  dataset_options.missing_images_ok = options.skip_bad_frames;  // skipped like any unreadable frame
+  p.source = io::open_source(options.dataset, dataset_options);
   if (const auto frames = p.source->summary().frames; frames && *frames == 0) {
     throw InputError(clip_text(options.dataset) + ": no frames");
   }

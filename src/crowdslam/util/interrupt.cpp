@@ -56,7 +56,8 @@ extern "C" void on_signal(int signal) {
     if (g_signal.compare_exchange_strong(expected, signal)) {
       write_stderr("\ninterrupted (");
       write_stderr(name_of(signal));
-      write_stderr("): stopping and writing the outputs; send it again to exit at once\n");
+      write_stderr(g_finishing.load() ? "): writing the outputs; send it twice more to exit at once\n"
+                                      : "): stopping and writing the outputs; send it again to exit at once\n");
       return;
     }
     if (g_finishing.load() && g_extra_signals.fetch_add(1) == 0) {
