@@ -241,7 +241,7 @@ class Fuzzer:
         if rng.random() < 0.1:
             rows += ["1,-1,10,10,20,40,0.9"] * 2500  # too many boxes in one frame
         if rng.random() < 0.1:
-            rows.append("x" * (2 << 20))  # a line longer than any text line
+            rows.append("x" * (9 << 20))  # a line longer than any text line (8 MiB)
         with open(path, "w") as f:
             f.write("\n".join(rows) + "\n")
         out = self.fresh(f"r{i}")
@@ -284,12 +284,25 @@ class Fuzzer:
         self.run("options", args, run_dir=out if out and os.path.isdir(out) and out != self.work else None)
 
     # --- the viewer -----------------------------------------------------------------------------------
-    def viewer_requests(self, port, count, deadline):
-        """Hostile requests to a live viewer; after each, /state must answer with valid JSON within 2 s."""
+    def viewer_requests(self, port, count, deadline, process):
+        """Hostile requests to a live viewer (paused meanwhile, a page connected); after each, /state must
+        answer with valid JSON within 2 s."""
         rng = self.rng
+        guard = socket.create_connection(("127.0.0.1", port), timeout=2)  # a page: the pause never times out
+        guard.sendall(b"GET /events?image=0 HTTP/1.1\r\n\r\n")
+        self.post(port, b"/control/pause")
         held = []  # open event streams and slowloris sockets, kept open
+        for _ in range(40):  # many viewers at once (beyond the cap of streams: 503)
+            s = socket.create_connection(("127.0.0.1", port), timeout=2)
+            s.sendall(b"GET /events HTTP/1.1\r\n\r\n")
+            held.append(s)
+        for _ in range(10):  # slowloris
+            s = socket.create_connection(("127.0.0.1", port), timeout=2)
+            s.sendall(b"GET /state HTTP/1.1\r\nX-a: 1\r\n")
+            held.append(s)
+        self.probe_state(port, "40 event streams and 10 slowloris sockets")
         for n in range(count):
-            if time.monotonic() > deadline:
+            if time.monotonic() > deadline or process.poll() is not None:
                 break
             self.cases += 1
             self.counts["viewer"] = self.counts.get("viewer", 0) + 1
@@ -318,8 +331,8 @@ class Fuzzer:
                     s.sendall(b"POST /client HTTP/1.1\r\nContent-Length: 99999999999\r\n\r\n{}")
                     s.close()
                 else:
-                    path = rng.choice([b"/control/pause", b"/control/step", b"/control/resume", b"/../etc/passwd",
-                                       b"/events?batch_ms=99999&image_width=-1"])
+                    path = rng.choice([b"/control/pause", b"/control/step", b"/../etc/passwd",
+                                       b"/events?batch_ms=99999&image_width=-1", b"/state?x=%zz"])
                     s.sendall(b"POST " + path + b" HTTP/1.1\r\nContent-Length: 0\r\n\r\n")
                     s.settimeout(2)
                     s.recv(4096)
@@ -333,6 +346,17 @@ class Fuzzer:
                 del held[:20]
         for s in held:
             s.close()
+        self.post(port, b"/control/resume")
+        guard.close()
+
+    def post(self, port, path):
+        try:
+            s = socket.create_connection(("127.0.0.1", port), timeout=2)
+            s.sendall(b"POST " + path + b" HTTP/1.1\r\nContent-Length: 0\r\n\r\n")
+            s.recv(4096)
+            s.close()
+        except OSError as e:
+            self.report("hang", f"POST {path.decode()}", str(e))
 
     def probe_state(self, port, what):
         start = time.monotonic()
@@ -391,7 +415,7 @@ class Fuzzer:
             self.report("contract", shown, "no viewer URL on stderr")
             process.kill()
             return
-        self.viewer_requests(port, count, deadline)
+        self.viewer_requests(port, count, deadline, process)
         try:
             out_text, _ = process.communicate(timeout=60)
         except subprocess.TimeoutExpired:
@@ -434,7 +458,7 @@ def main():
     try:
         fuzzer.prepare()
         file_kinds = [k for k in kinds if k != "viewer"]
-        viewer_share = args.cases // 5 if "viewer" in kinds else 0
+        viewer_share = (args.cases if kinds == ["viewer"] else args.cases // 5) if "viewer" in kinds else 0
         file_cases = args.cases - viewer_share
         # The viewer's turn is kept for the last part of the budget.
         file_deadline = deadline - (min(20.0, args.time_budget / 3) if viewer_share else 0)

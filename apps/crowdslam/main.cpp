@@ -19,7 +19,8 @@ namespace {
 bool g_json_printed = false;
 }
 void print_json(const nlohmann::json& document) {
-  std::cout << document.dump(2) << '\n';
+  // Text from a hostile file (a map's blob in an error message) may be invalid UTF-8: replaced, never a throw.
+  std::cout << document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   g_json_printed = true;
 }
 }  // namespace crowdslam::app

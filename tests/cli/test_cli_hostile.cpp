@@ -186,7 +186,7 @@ TEST_F(CliHostile, SpecialFilesAndDirectoriesAreRefusedAtOnce) {
   {
     std::ofstream out(blob, std::ios::binary);
     const std::string zeros(1 << 20, '\0');
-    for (int i = 0; i < 3; ++i) out << zeros;
+    for (int i = 0; i < 9; ++i) out << zeros;
   }
   expect_one_line_error(run_cli({"eval", "ate", blob.string(), gt.string()}), {"blob.txt:1", "longer than"});
 }

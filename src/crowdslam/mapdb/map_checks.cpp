@@ -114,7 +114,13 @@ void check_map_rows(Database& db) {
     }
     auto st = db.prepare("SELECT label, bad FROM (SELECT " + std::string(t.row_label) + " AS label, CASE" + cases +
                          " END AS bad FROM " + t.table + ") WHERE bad IS NOT NULL LIMIT 1");
-    if (st.step()) corrupt_row(db, clip_text(st.text(0), 100) + ": " + st.text(1));
+    if (st.step()) {
+      std::string label = clip_text(st.text(0), 100);
+      for (char& c : label) {  // a blob where an id belongs: its bytes are not text
+        if (static_cast<unsigned char>(c) >= 0x80) c = '?';
+      }
+      corrupt_row(db, label + ": " + st.text(1));
+    }
   }
 }
 

@@ -149,7 +149,8 @@ void write_final_outputs(const std::filesystem::path& out, const system::System&
   // Frames bridged while people hid the view: not tracked, so never in CameraTrajectory.txt.
   const io::Trajectory bridged = slam.bridged_trajectory();
   if (!bridged.empty()) io::write_trajectory((out / "BridgedTrajectory.txt").string(), bridged, format);
-  write_file_atomic(out / "run.json", doc.dump(1) + "\n");
+  // Replaced, never thrown: a path or an error message may hold bytes that are not UTF-8.
+  write_file_atomic(out / "run.json", doc.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 // What the progress line shows after the counts: state, tracked frames, keyframes, map points, people.
@@ -202,7 +203,9 @@ RunSummary run_sequence(const RunOptions& options) {
   journal_options.flush_every_poses = options.journal_flush_frames;
   std::unique_ptr<journal::RunJournal> journal_ptr;
   try {
-    write_file_atomic(out / "run.json", running_document(options, p.settings_path, p.sensor).dump(1) + "\n");
+    write_file_atomic(out / "run.json", running_document(options, p.settings_path, p.sensor)
+                                            .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                                            "\n");
     journal_ptr = std::make_unique<journal::RunJournal>(journal_options);
   } catch (...) {  // nothing was run yet: leave nothing behind
     if (created) {

@@ -73,6 +73,13 @@ AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
   if (path_.has_parent_path() && !std::filesystem::is_directory(path_.parent_path(), ec)) {
     throw input_error(path_.string(), "output directory does not exist");
   }
+  // Renaming over a device, FIFO, socket or directory would replace it (as root, /dev/null itself).
+  const auto type = std::filesystem::symlink_status(path_, ec).type();
+  if (!ec && type != std::filesystem::file_type::not_found && type != std::filesystem::file_type::regular &&
+      type != std::filesystem::file_type::symlink) {
+    throw input_error(path_.string(), "exists and is not a regular file (a directory, device, FIFO or socket); "
+                                      "refusing to replace it");
+  }
   registry_slot_ = temp_files::add(tmp_path_.string());
   fd_ = ::open(tmp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {

@@ -1,7 +1,8 @@
 #pragma once
 // Writing output files without ever leaving a half-written one behind.
 //
-// AtomicFile writes into "<path>.tmp.<pid>" and renames it onto <path> on commit(), after an fsync of the
+// AtomicFile refuses a <path> that is a directory, device, FIFO or socket (never replaced). It writes
+// into "<path>.tmp.<pid>" and renames it onto <path> on commit(), after an fsync of the
 // data (and of the directory after the rename). If the object is destroyed without commit() (an exception
 // was thrown while writing), the temporary is removed and <path> is untouched. While open, the temporary
 // is registered with util/interrupt.h, so SIGINT/SIGTERM/SIGHUP remove it too.

@@ -97,6 +97,7 @@ const char* http_reason(int status) {
     case 409: return "Conflict";
     case 413: return "Payload Too Large";
     case 431: return "Request Header Fields Too Large";
+    case 500: return "Internal Server Error";
     case 503: return "Service Unavailable";
     default: return "Status";
   }
@@ -177,7 +178,10 @@ void HttpServer::accept_loop() {
     ++connections_;
     connections_list_.push_back(std::move(connection));
     c.thread = std::thread([this, &c] {
-      serve(c);
+      try {
+        serve(c);
+      } catch (const std::exception&) {  // a failed stream ends its connection, never the process
+      }
       {
         std::lock_guard guard(mutex_);
         ::close(c.fd);
@@ -367,7 +371,14 @@ void HttpServer::serve(Connection& connection) {
   HttpResponse response;
   const auto route = routes_.find({request.method, request.path});
   if (route != routes_.end()) {
-    route->second(request, response);
+    try {
+      route->second(request, response);
+    } catch (const std::exception& e) {  // never out of the connection's thread (that would terminate)
+      response = HttpResponse();
+      response.status = 500;
+      response.content_type = "application/json";
+      response.body = "{\"error\":\"internal error\"}";
+    }
   } else {
     const bool other_method = std::any_of(routes_.begin(), routes_.end(),
                                           [&](const auto& r) { return r.first.second == request.path; });
