@@ -136,6 +136,16 @@ class Fuzzer:
             self.settings_lines = f.read().splitlines()
         self.fifo = os.path.join(self.work, "fifo")
         os.mkfifo(self.fifo)
+        # Devices to write to are our own nodes (as root), never the real /dev ones: a binary that still
+        # replaces a device (an older crowdslam) must not take the machine's /dev/null with it.
+        self.write_targets = [self.fifo, self.work]
+        for name, minor in (("null", 3), ("full", 7)):
+            path = os.path.join(self.work, name)
+            try:
+                os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, minor))
+                self.write_targets.append(path)
+            except OSError:
+                pass
 
     # --- generators -----------------------------------------------------------------------------------
     def hostile_map(self, path):
@@ -249,26 +259,37 @@ class Fuzzer:
                                 "--allow-untracked"], must_not_exist_on_error=[out], run_dir=out)
 
     def case_special(self, i):
-        target = self.rng.choice(["/dev/zero", "/dev/null", self.fifo, self.work, "/dev/full"])
         out = self.fresh(f"r{i}")
         gt = os.path.join(self.dataset, "groundtruth.txt")
-        before = os.stat(target, follow_symlinks=False)
+        # Written to: only our own special files (prepare()).
+        target = self.rng.choice(self.write_targets)
+        writes = [
+            ["run", "--dataset", self.dataset, "--out", out, "--save-map", target, "--overwrite", "--frames", "2"],
+            ["map", "optimise", self.base_map, "--out", target, "--overwrite"],
+            ["map", "export", self.base_map, "--ply", target],
+            ["eval", "ate", gt, gt, "--save-aligned", target],
+        ]
+        if self.rng.random() < 0.35:
+            args = self.rng.choice(writes)
+            before = os.stat(target, follow_symlinks=False)
+            self.run("special", args, timeout=20, run_dir=out if args[0] == "run" else None)
+            after = os.stat(target, follow_symlinks=False)
+            if stat.S_IFMT(before.st_mode) != stat.S_IFMT(after.st_mode):
+                self.report("leftover", " ".join(args), f"{target} was replaced")
+            return
+        # Only read: the real /dev/zero too.
+        target = self.rng.choice(["/dev/zero"] + self.write_targets)
         cases = [
             ["run", "--dataset", self.dataset, "--out", out, "--settings", target],
             ["run", "--dataset", self.dataset, "--out", out, "--detections", target],
             ["run", "--dataset", self.dataset, "--out", out, "--vocabulary", target],
             ["run", "--dataset", self.dataset, "--out", out, "--load-map", target],
-            ["run", "--dataset", self.dataset, "--out", out, "--save-map", target, "--overwrite", "--frames", "2"],
             ["run", "--dataset", target, "--out", out],
             ["eval", "ate", target, gt], ["eval", "rpe", gt, target], ["vocab", "info", target],
-            ["map", "info", target], ["map", "optimise", self.base_map, "--out", target, "--overwrite"],
-            ["map", "export", self.base_map, "--ply", target],
+            ["map", "info", target],
         ]
         args = self.rng.choice(cases)
         self.run("special", args, timeout=20, run_dir=out if args[0] == "run" else None)
-        after = os.stat(target, follow_symlinks=False)
-        if stat.S_IFMT(before.st_mode) != stat.S_IFMT(after.st_mode):
-            self.report("leftover", " ".join(args), f"{target} was replaced")
 
     def case_options(self, i):
         out = self.fresh(f"r{i}")
