@@ -1,11 +1,14 @@
 // `crowdslam map info|export|optimise`: look into a saved map, export it for other tools, refine it.
+#include <filesystem>
 #include <iostream>
 
 #include "commands.h"
 #include "crowdslam/mapdb/map_database.h"
 #include "crowdslam/mapdb/map_export.h"
+#include "crowdslam/mapdb/map_target.h"
 #include "crowdslam/system/map_optimise.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::app {
 
@@ -104,6 +107,23 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
     if (args->ply.empty() && args->keyframes.empty() && args->trajectory.empty()) {
       throw InputError("map export: give at least one of --ply, --keyframes, --trajectory");
     }
+    // Never over the map itself, another map, a special file, or each other.
+    mapdb::read_map_header(args->file);  // the input is a map (a clear error first)
+    const std::vector<std::pair<const char*, std::string*>> outputs = {
+        {"--ply", &args->ply}, {"--keyframes", &args->keyframes}, {"--trajectory", &args->trajectory}};
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      if (outputs[i].second->empty()) continue;
+      mapdb::check_export_target(*outputs[i].second, args->file, outputs[i].first);
+      for (size_t j = 0; j < i; ++j) {
+        std::error_code ec;
+        const auto a = std::filesystem::weakly_canonical(*outputs[i].second, ec);
+        const auto b = std::filesystem::weakly_canonical(*outputs[j].second, ec);
+        if (!outputs[j].second->empty() && !ec && a == b) {
+          throw InputError(std::string(outputs[i].first) + " and " + outputs[j].first + ": the same file (" +
+                           clip_text(*outputs[i].second) + "); give each export its own path");
+        }
+      }
+    }
     nlohmann::json doc = {{"file", args->file}};
     if (!args->ply.empty()) doc["points"] = mapdb::export_points_ply(args->file, args->ply);
     if (!args->keyframes.empty()) doc["keyframes"] = mapdb::export_keyframes_ply(args->file, args->keyframes);
@@ -136,6 +156,8 @@ void add_map_command(CLI::App& app, const GlobalOptions& global) {
                        "each keyframe's ground at one height, with this relative sigma per keyframe (as "
                        "Ground.keyframe_sigma, e.g. 0.01; 0 = off)");
   optimise->callback([opt, &global] {
+    // Only a new file or (--overwrite) a crowdslam map is replaced, checked before the work.
+    mapdb::check_map_target(opt->output, opt->options.overwrite, "--out");
     const auto r = system::optimise_saved_map(opt->input, opt->output, opt->options);
     const nlohmann::json doc = {{"file", opt->input},       {"out", opt->output},
                                 {"keyframes", r.keyframes}, {"map_points", r.map_points},

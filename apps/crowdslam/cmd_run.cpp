@@ -18,6 +18,22 @@ struct RunArgs {
   size_t frames = 0;
 };
 
+// A count (frames): digits only, so that -1 is an error rather than a huge number.
+CLI::Validator count() {
+  return CLI::Validator(
+      [](std::string& value) {
+        return !value.empty() && value.size() <= 12 && value.find_first_not_of("0123456789") == std::string::npos
+                   ? std::string()
+                   : "expected a whole number >= 0, got '" + value.substr(0, 40) + "'";
+      },
+      "", "COUNT");
+}
+
+CLI::Validator non_empty() {
+  return CLI::Validator([](std::string& value) { return value.empty() ? std::string("empty value") : std::string(); },
+                        "", "NON-EMPTY");
+}
+
 void print_summary(const run::RunSummary& summary) {
   std::cout << "end state         " << summary.end.to_string() << "\n"
             << "frames            " << summary.frames << "\n"
@@ -77,7 +93,8 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "left images only)");
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
-  cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)");
+  cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)")
+      ->check(count());
   cmd->add_flag(
       "!--no-people-filter", args->options.people_filter,
       "Run without the people filter and without the feature-number update (static-world baseline)");
@@ -107,7 +124,8 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "global BA that holds each keyframe's ground at one height, against scale drift; off: not "
                   "(Ground.enabled; config/KITTI*.yaml turn it on)");
   cmd->add_option("--save-frames", args->options.save_frames,
-                  "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/");
+                  "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/")
+      ->check(count());
   cmd->add_option(
       "--vocabulary", args->options.vocabulary,
       "ORB vocabulary for relocalisation (default: $CROWDSLAM_VOCABULARY or vocabulary/crowdslam_orb.voc); "
@@ -123,8 +141,10 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                 "Skip (count and warn about) frames that cannot be read instead of failing the run");
   cmd->add_flag("--allow-untracked", args->options.allow_untracked,
                 "Exit 0 even when no frame could be tracked");
-  cmd->add_option("--save-map", args->options.save_map,
-                  "Write the final map to this SQLite file (atomically; also for an interrupted run)");
+  auto* save_map = cmd->add_option(
+      "--save-map", args->options.save_map,
+      "Write the final map to this SQLite file (atomically; also for an interrupted run). An existing file is "
+      "replaced only when it is a crowdslam map and --overwrite is given");
   cmd->add_option(
       "--load-map", args->options.load_map,
       "Start in this saved map: relocalise into it, then extend it (or only track with --localization)");
@@ -135,9 +155,19 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "Address the viewer listens on (default 127.0.0.1; the viewer has no authentication)");
   cmd->add_option("--viewer-port", args->options.viewer_port, "Viewer port (default 8080; 0: any free port)")
       ->check(CLI::Range(0, 65535));
+  cmd->add_option("--viewer-pause-timeout", args->options.viewer_pause_timeout_s,
+                  "Seconds a run paused from the viewer stays paused with no viewer page connected before it "
+                  "resumes by itself (default 60; 0: stays paused until resumed or interrupted)")
+      ->check(CLI::Range(0.0, 86400.0));
   cmd->add_flag("--localization", args->options.localization,
                 "With --load-map: localisation only, no keyframe or map point is created or removed");
-  cmd->callback([args, &global] {
+  // A path or name given as "" is a mistake, never "use the default".
+  for (const char* name : {"--dataset", "--settings", "--out", "--detections", "--detector", "--vocabulary",
+                           "--load-map", "--save-map", "--viewer-host", "--sensor"}) {
+    cmd->get_option(name)->check(non_empty());
+  }
+  cmd->callback([args, save_map, &global] {
+    args->options.save_map_given = save_map->count() > 0;
     if (!args->sensor.empty()) args->options.sensor = io::parse_sensor_kind(args->sensor, "--sensor");
     args->options.max_frames = args->frames;
     args->options.pace_sensor = args->pace == "sensor";

@@ -12,6 +12,7 @@
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/mapdb/map_export.h"
+#include "crowdslam/run/viewer_session.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/interrupt.h"
 #include "crowdslam/viewer/event_stream.h"
@@ -68,7 +69,8 @@ std::string publish_result(const fs::path& target, viewer::EventStream& stream) 
   }
   const auto saved = run.is_object() && run.contains("map") && run["map"].is_object() ? run["map"]["saved"] : nullptr;
   std::string what;
-  if (saved.is_object() && fs::exists(saved["path"].get<std::string>())) {
+  if (saved.is_object() && saved.contains("path") && saved["path"].is_string() &&
+      fs::is_regular_file(saved["path"].get<std::string>())) {
     const auto contents = mapdb::read_map_contents(saved["path"].get<std::string>());
     stream.publish("map", viewer::map_json(snapshot_of(contents)));
     what = ", map " + saved["path"].get<std::string>();
@@ -83,7 +85,7 @@ std::string publish_result(const fs::path& target, viewer::EventStream& stream) 
       const auto ground_truth = source->ground_truth();
       std::vector<std::pair<double, geometry::Vec3>> estimate;
       for (const auto& pose : trajectory) estimate.emplace_back(pose.timestamp_s, pose.world_from_cam.translation());
-      const bool mono = run.value("sensor", std::string()) == "mono";
+      const bool mono = run.contains("sensor") && run["sensor"] == "mono";
       if (const auto alignment = viewer::align_ground_truth(ground_truth, estimate, mono)) {
         stream.publish("ground_truth", viewer::ground_truth_json(ground_truth, *alignment, 3000));
       }
@@ -91,12 +93,13 @@ std::string publish_result(const fs::path& target, viewer::EventStream& stream) 
       spdlog::info("no ground truth shown: {}", e.what());
     }
   }
-  stream.publish("finish", nlohmann::json({{"end_state", run.is_object() ? run.value("end_state", std::string("?")) : "?"}}).dump());
+  const bool has_end = run.is_object() && run.contains("end_state") && run["end_state"].is_string();
+  stream.publish("finish", nlohmann::json({{"end_state", has_end ? run["end_state"].get<std::string>() : "?"}}).dump());
   return "run " + target.string() + ": " + std::to_string(trajectory.size()) + " poses" + what;
 }
 }  // namespace
 
-void add_view_command(CLI::App& app, const GlobalOptions& /*global*/) {
+void add_view_command(CLI::App& app, const GlobalOptions& global) {
   struct ViewArgs {
     std::string target;
     viewer::ViewerServerOptions server;
@@ -106,14 +109,25 @@ void add_view_command(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("target", args->target, "A map saved with --save-map, or a run's --out directory")->required();
   cmd->add_option("--viewer-host", args->server.host, "Address to listen on (default 127.0.0.1; no authentication)");
   cmd->add_option("--viewer-port", args->server.port, "Port (default 8080; 0: any free port)")->check(CLI::Range(0, 65535));
-  cmd->callback([args] {
+  cmd->callback([args, &global] {
     viewer::EventStream stream;
     const std::string what = publish_result(args->target, stream);
     viewer::ViewerServer server(args->server, stream, nullptr, [] { return std::string("{\"finished\":true}"); });
     InterruptScope interrupts;
     server.start();
-    spdlog::info("viewer: {} ({}); Ctrl-C to stop", server.url(), what);
-    std::cout << server.url() << std::endl;
+    // The URL is the result: on stderr whatever the log level (with port 0 the only way to learn the
+    // port), and on stdout (with --json as its one document).
+    std::cerr << "viewer: " << server.url() << " (" << what << "); Ctrl-C to stop" << std::endl;
+    if (!run::is_loopback_host(args->server.host)) {
+      spdlog::warn("viewer: listening on {}, not a loopback address: anyone who can reach it can see this map "
+                   "(no authentication)",
+                   args->server.host);
+    }
+    if (global.json) {
+      print_json({{"url", server.url()}, {"port", server.port()}, {"target", args->target}, {"showing", what}});
+    } else {
+      std::cout << server.url() << std::endl;
+    }
     while (!interrupted()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
     clear_interrupt();
     server.stop();

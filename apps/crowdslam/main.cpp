@@ -19,14 +19,19 @@ namespace {
 bool g_json_printed = false;
 }
 void print_json(const nlohmann::json& document) {
-  std::cout << document.dump(2) << '\n';
+  // Text from a hostile file (a map's blob in an error message) may be invalid UTF-8: replaced, never a throw.
+  std::cout << document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   g_json_printed = true;
 }
 }  // namespace crowdslam::app
 
 namespace {
 // One line on stderr; with --json also one JSON document on stdout, unless the command printed its own.
-int fail(const crowdslam::app::GlobalOptions& global, const std::string& message, int code) {
+int fail(const crowdslam::app::GlobalOptions& global, std::string message, int code) {
+  // One line, whatever the message holds (an SQLite report, a multi-line parse error).
+  for (char& c : message) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
   std::cerr << "error: " << message << '\n';
   if (global.json && !crowdslam::app::g_json_printed) {
     crowdslam::app::print_json({{"error", message}, {"exit_code", code}});
@@ -74,10 +79,22 @@ int main(int argc, char** argv) {
   add_view_command(app, global);
   add_report_command(app, global);
 
+  // --json is known before parsing, so that a parse error is a JSON document too.
+  for (int i = 1; i < argc && std::string(argv[i]) != "--"; ++i) {
+    if (std::string(argv[i]) == "--json") global.json = true;
+  }
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // Bad arguments are bad input: exit 1 with one line (and --json's document), not CLI11's own codes.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    return fail(global, crowdslam::clip_text(e.what(), 1000) + " (see --help)", 1);
   } catch (const crowdslam::Interrupted& e) {
     return fail(global, e.what(), e.exit_code());
   } catch (const crowdslam::InputError& e) {

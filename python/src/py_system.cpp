@@ -9,6 +9,7 @@
 #include <ctime>
 #include <set>
 
+#include "crowdslam/mapdb/map_target.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 #include "crowdslam/util/version.h"
@@ -98,6 +99,13 @@ FrameResult PySystem::track(const py::object& image, const py::object& depth, co
   if (!std::isfinite(timestamp_s)) {
     throw py::value_error("track(): timestamp: expected a finite time in seconds, got " + std::to_string(timestamp_s));
   }
+  if (const double last = last_timestamp_s_.load(); !std::isnan(last) && timestamp_s <= last) {
+    // Accepted (frames are taken in the order given), but never silently: motion and pacing assume time
+    // goes forward.
+    const std::string message = "track(): timestamp " + std::to_string(timestamp_s) +
+                                " is not after the previous frame's (" + std::to_string(last) + ")";
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+  }
   const io::SensorKind sensor = args_.options.sensor;
   const std::string sensor_name = io::to_string(sensor);
   py::object keep_image, keep_depth, keep_right;  // own the memory the cv::Mats point into
@@ -132,6 +140,7 @@ FrameResult PySystem::track(const py::object& image, const py::object& depth, co
     check_frame(call, images.colour, images.depth, images.right);
     FrameResult result;
     result.report = slam.track(images, timestamp_s);
+    last_timestamp_s_.store(timestamp_s);
     result.world_from_cam = observer_.last_pose;
     return result;
   });
@@ -254,6 +263,8 @@ void PySystem::save_map(const std::string& path, const std::string& dataset) {
     origin.created_utc = utc_now();
     origin.crowdslam_version = crowdslam::version();
     origin.end_state = closed_ ? "completed" : "running";
+    // As the CLI's --save-map with --overwrite: a new file or a crowdslam map, never anything else.
+    mapdb::check_map_target(path, true, "save_map(): path");
     slam.save_map(path, origin);
   });
 }

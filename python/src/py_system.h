@@ -15,6 +15,7 @@
 #include <pybind11/pybind11.h>
 
 #include <atomic>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -85,6 +86,8 @@ class PySystem {
   PoseObserver observer_;
   std::atomic<bool> closed_{false};  // shutdown() was called: track() refuses, the results stay
   std::optional<cv::Size> first_size_;
+  // Of the last frame tracked (NaN: none yet); a timestamp not after it is warned about (RuntimeWarning).
+  std::atomic<double> last_timestamp_s_{std::numeric_limits<double>::quiet_NaN()};
 };
 
 // Registers System, FrameResult and the module-level stop_all() on `m`.

@@ -143,6 +143,7 @@ TEST_F(MapErrors, FailedSaveLeavesTheOldFileUntouched) {
   std::ofstream(blocker / "inside") << "x";
   auto options = test::run_options(room_, *tmp_ / "failed-save");
   options.save_map = path.string();
+  options.overwrite = true;  // an existing map is replaced only with --overwrite (issue 37)
   EXPECT_THROW(run::run_sequence(options), InputError);
   EXPECT_TRUE(test::dump_table(path, "keyframes") == before);
   // The run's outputs say so.

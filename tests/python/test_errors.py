@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import crowdslam
-from conftest import SOURCE_DIR, run_cli
+from conftest import SOURCE_DIR, run_cli, vocabulary_available
 
 
 @pytest.fixture(scope="module")
@@ -108,3 +108,46 @@ def test_closed_system_refuses_to_track(synth_settings: Path, frame) -> None:
     assert slam.trajectory().shape == (1, 8)  # results stay readable
     with pytest.raises(RuntimeError, match=r"load_map\(\): the System is closed"):
         slam.load_map("whatever.db")
+
+
+def test_timestamps_going_backwards_are_warned_about(synth_settings: Path, synth_sequence: Path) -> None:
+    """Issue 37, finding 16: a frame whose timestamp is not after the previous one was taken silently."""
+    frames = crowdslam.datasets.open(synth_sequence)
+    with crowdslam.System(synth_settings, sequential=True, people_filter=False, vocabulary="none") as s:
+        s.track(frames[1].image, frames[1].depth, timestamp=frames[1].timestamp)
+        with pytest.warns(RuntimeWarning, match=r"track\(\): timestamp .* is not after the previous frame's"):
+            s.track(frames[0].image, frames[0].depth, timestamp=frames[0].timestamp)
+
+
+def test_corrupt_map_metadata_is_a_clear_error(synth_settings: Path, synth_sequence: Path, tmp_path: Path) -> None:
+    """Issue 37, finding 12: 'abc' as the next keyframe id was ValueError('stoull')."""
+    import sqlite3
+
+    frames = crowdslam.datasets.open(synth_sequence)
+    path = tmp_path / "m.db"
+    with crowdslam.System(synth_settings, sequential=True, people_filter=False, vocabulary="none") as s:
+        for f in [frames[i] for i in range(10)]:
+            s.track(f.image, f.depth, timestamp=f.timestamp)
+        s.save_map(str(path))
+    with sqlite3.connect(path) as db:
+        db.execute("UPDATE metadata SET value = 'abc' WHERE key = 'map.next_keyframe_id'")
+    if not vocabulary_available():
+        pytest.skip("loading a map needs the default vocabulary (scripts/setup.sh builds it)")
+    with crowdslam.System(synth_settings, sequential=True, people_filter=False) as s:
+        with pytest.raises(ValueError, match=r"m\.db: corrupt map: metadata map\.next_keyframe_id is not an id: abc"):
+            s.load_map(str(path))
+
+
+def test_save_map_never_replaces_what_is_not_a_map(synth_settings: Path, synth_sequence: Path, tmp_path: Path) -> None:
+    """Issue 37, finding 1: save_map() renamed a map over whatever the path named."""
+    frames = crowdslam.datasets.open(synth_sequence)
+    other = tmp_path / "important.yaml"
+    other.write_text("%YAML:1.0\n")
+    with crowdslam.System(synth_settings, sequential=True, people_filter=False, vocabulary="none") as s:
+        for i in range(5):
+            s.track(frames[i].image, frames[i].depth, timestamp=frames[i].timestamp)
+        with pytest.raises(ValueError, match=r"save_map\(\): path .*important\.yaml: exists and is not a crowdslam map"):
+            s.save_map(str(other))
+        s.save_map(str(tmp_path / "m.db"))
+        s.save_map(str(tmp_path / "m.db"))  # a map may be replaced
+    assert other.read_text() == "%YAML:1.0\n"

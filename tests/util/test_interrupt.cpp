@@ -89,3 +89,28 @@ TEST(Interrupt, CommittedFilesAreNotRemoved) {
   ASSERT_TRUE(WIFSIGNALED(status));
   EXPECT_EQ(crowdslam::test::read_text(target), "complete\n");
 }
+
+// Issue 37, finding 15: a second Ctrl-C while the outputs are written left run.json "running"; while a
+// FinishingScope lives, the second signal only says so, and a third exits at once.
+TEST(Interrupt, WhileFinishingASecondSignalIsNotFatalAndAThirdIs) {
+  const int survived = in_child([] {
+    crowdslam::InterruptScope scope;
+    std::raise(SIGINT);
+    crowdslam::FinishingScope finishing;
+    std::raise(SIGINT);
+    if (crowdslam::interrupt_signal() != SIGINT) _exit(3);
+    _exit(0);
+  });
+  ASSERT_TRUE(WIFEXITED(survived)) << "killed by signal " << WTERMSIG(survived);
+  EXPECT_EQ(WEXITSTATUS(survived), 0);
+  const int third = in_child([] {
+    crowdslam::InterruptScope scope;
+    crowdslam::FinishingScope finishing;
+    std::raise(SIGINT);
+    std::raise(SIGINT);
+    std::raise(SIGINT);
+    _exit(0);  // not reached
+  });
+  ASSERT_TRUE(WIFEXITED(third));
+  EXPECT_EQ(WEXITSTATUS(third), 128 + SIGINT);
+}

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <ctime>
@@ -56,4 +57,32 @@ TEST(Text, UtcNowIsTheCurrentTimeInTheGivenFormat) {
   const std::string report = utc_now("%Y-%m-%d %H:%M UTC");
   EXPECT_EQ(report.substr(0, 10), iso.substr(0, 10));
   EXPECT_EQ(report.substr(report.size() - 4), " UTC");
+}
+
+// Issue 37, finding 6: /dev/zero read for ever (16.8 GB); a directory said "read error".
+TEST(Text, ReadLinesRefusesSpecialFilesDirectoriesAndEndlessLines) {
+  test::TempDir tmp;
+  const auto message = [](const std::string& path) {
+    try {
+      read_lines(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message("/dev/zero"), "/dev/zero: not a regular file (a device, FIFO or socket is not read)");
+  EXPECT_EQ(message(tmp.path().string()), tmp.path().string() + ": is a directory, not a file");
+  const auto fifo = tmp / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(message(fifo.string()).find("not a regular file"), std::string::npos);  // and no hang
+  test::write_text(tmp / "long.txt", "ok\n" + std::string(3000, 'x') + "\nok\n");
+  EXPECT_EQ(read_lines((tmp / "long.txt").string(), 4096).size(), 3u);
+  try {
+    read_lines((tmp / "long.txt").string(), 1000);
+    FAIL() << "a line over the limit must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("long.txt:2: line longer than 1000 bytes"), std::string::npos) << e.what();
+  }
+  test::write_text(tmp / "last.txt", "a\nb");  // no final newline
+  EXPECT_EQ(read_lines((tmp / "last.txt").string()), (std::vector<std::string>{"a", "b"}));
 }

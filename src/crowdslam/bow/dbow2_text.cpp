@@ -12,6 +12,7 @@
 #include "crowdslam/feature/descriptor.h"
 #include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::bow {
 namespace {
@@ -42,6 +43,7 @@ bool parse_number(std::string_view token, T& value) {
 }  // namespace
 
 Vocabulary Vocabulary::import_dbow2_text(const std::string& path) {
+  check_regular_file(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw input_error(path, "cannot open vocabulary file");
   std::ostringstream content_stream;

@@ -8,6 +8,7 @@
 #include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::bow {
 namespace {
@@ -40,6 +41,7 @@ struct FileCloser {
 
 // The whole file in one buffer.
 std::vector<char> read_all(const std::string& path) {
+  check_regular_file(path);  // a directory or /dev/zero is never read
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
   if (!file) throw input_error(path, "cannot open vocabulary file");
   if (std::fseek(file.get(), 0, SEEK_END) != 0) throw input_error(path, "cannot seek in vocabulary file");
@@ -54,6 +56,7 @@ std::vector<char> read_all(const std::string& path) {
 }
 
 bool has_magic(const std::string& path) {
+  check_regular_file(path);
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
   if (!file) throw input_error(path, "cannot open vocabulary file");
   char magic[sizeof kMagic] = {};

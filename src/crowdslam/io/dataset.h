@@ -83,6 +83,9 @@ struct DatasetOptions {
   double fps = 0.0;                     // image folders / videos: frame rate for timestamps; 0 = default
                                         // (video: the file's rate, else 30; image folder: 30)
   double max_time_difference_s = 0.02;  // TUM colour-depth association window
+  // A listed image that does not exist is kept as a frame (its load fails, and a run with
+  // --skip-bad-frames skips it) instead of failing the open.
+  bool missing_images_ok = false;
 
   void check() const;  // throws InputError naming the bad value
 };

@@ -40,6 +40,18 @@ bool is_comment_or_blank(const std::string& line) {
   return t.empty() || t[0] == '#';
 }
 
+// Warns (once per list) when a time stamp is not after the one before it: a reversed or unsorted list
+// is used, never silently.
+static void warn_if_unordered(const std::vector<ListEntry>& entries, const std::string& path) {
+  for (std::size_t i = 1; i < entries.size(); ++i) {
+    if (entries[i].timestamp_s < entries[i - 1].timestamp_s) {
+      spdlog::warn("{}:{}: time stamp {:.6f} is before the previous line's ({:.6f}); the list is not in time order",
+                   clip_text(path), entries[i].line, entries[i].timestamp_s, entries[i - 1].timestamp_s);
+      return;
+    }
+  }
+}
+
 std::vector<ListEntry> read_tum_list(const std::string& path) {
   std::vector<ListEntry> entries;
   const auto lines = lines_of(path);
@@ -53,6 +65,7 @@ std::vector<ListEntry> read_tum_list(const std::string& path) {
     entries.push_back({parse_stamp(fields[0], path, line), 0, fields[1], line});
   }
   if (entries.empty()) throw input_error(clip_text(path), "list is empty");
+  warn_if_unordered(entries, path);
   return entries;
 }
 
@@ -76,6 +89,7 @@ std::vector<ListEntry> read_euroc_list(const std::string& path) {
     entries.push_back({stamp_s, *ns, fields[1], line});
   }
   if (entries.empty()) throw input_error(clip_text(path), "list is empty");
+  warn_if_unordered(entries, path);
   return entries;
 }
 
@@ -91,12 +105,18 @@ std::vector<ListEntry> read_times_list(const std::string& path) {
     stamps.push_back({parse_stamp(fields[0], path, line), 0, {}, line});
   }
   if (stamps.empty()) throw input_error(clip_text(path), "list is empty");
+  warn_if_unordered(stamps, path);
   return stamps;
 }
 
-void require_listed_file(const std::string& file, const std::string& list, int line) {
+void require_listed_file(const std::string& file, const std::string& list, int line, bool missing_ok) {
   std::error_code ec;
   const fs::file_status status = fs::status(file, ec);
+  if (status.type() == fs::file_type::not_found && missing_ok) {
+    spdlog::warn("{}:{}: listed image {} does not exist (its frame will be skipped)", clip_text(list), line,
+                 clip_text(file));
+    return;
+  }
   if (status.type() == fs::file_type::not_found)
     throw input_error(clip_text(list), line, "listed image " + clip_text(file) + " does not exist");
   if (ec) throw input_error(clip_text(list), line, "listed image " + clip_text(file) + ": " + ec.message());

@@ -29,8 +29,9 @@ std::vector<ListEntry> read_times_list(const std::string& path);
 
 // Throws InputError "LIST:LINE: listed image FILE does not exist" unless `file` is a regular file; a path
 // that cannot be checked (too long, a symlink loop, no permission) is "LIST:LINE: listed image FILE:
-// reason". FILE is clipped (input_text.h).
-void require_listed_file(const std::string& file, const std::string& list, int line);
+// reason". FILE is clipped (input_text.h). With `missing_ok` a file that does not exist is accepted
+// (counted in `missing`, warned about once).
+void require_listed_file(const std::string& file, const std::string& list, int line, bool missing_ok = false);
 
 // The entries kept when the list is read into a dict keyed by stamp (`by_ns`: timestamp_ns, else
 // timestamp_s): of equal stamps the later entry wins, as in TUM's associate.py. Ascending by stamp.

@@ -62,13 +62,13 @@ EurocCameraCalibration parse_calibration(const cv::FileStorage& fs, const std::s
 
 // Full paths of a camera's list, checking each file exists; keyed by ns stamp (of duplicated stamps the
 // later row wins, warned once).
-std::map<long long, ListEntry> camera_entries(const fs::path& cam_dir, std::size_t& count) {
+std::map<long long, ListEntry> camera_entries(const fs::path& cam_dir, std::size_t& count, bool missing_ok) {
   const std::string list = (cam_dir / "data.csv").string();
   auto rows = read_euroc_list(list);
   count = rows.size();
   for (auto& row : rows) {
     row.file = (cam_dir / "data" / row.file).string();
-    require_listed_file(row.file, list, row.line);
+    require_listed_file(row.file, list, row.line, missing_ok);
   }
   std::map<long long, ListEntry> entries;
   for (auto& row : without_duplicate_stamps(rows, list, true))
@@ -133,13 +133,13 @@ std::unique_ptr<EurocDataset> open_euroc_dataset(const std::string& directory,
   DatasetContents c;
   c.directory = directory;
   c.layout = "euroc";
-  const auto left = camera_entries(mav0 / "cam0", c.colour_entries);
+  const auto left = camera_entries(mav0 / "cam0", c.colour_entries, options.missing_images_ok);
   const auto left_calibration = read_euroc_camera_calibration((mav0 / "cam0" / "sensor.yaml").string());
   std::optional<EurocCameraCalibration> right_calibration;
   std::error_code ec;
   if (fs::exists(mav0 / "cam1" / "data.csv", ec)) {
     c.sensor = SensorKind::kStereo;
-    const auto right = camera_entries(mav0 / "cam1", c.right_entries);
+    const auto right = camera_entries(mav0 / "cam1", c.right_entries, options.missing_images_ok);
     right_calibration = read_euroc_camera_calibration((mav0 / "cam1" / "sensor.yaml").string());
     for (const auto& [ns, entry] : left) {
       const auto match = right.find(ns);

@@ -115,8 +115,8 @@ std::unique_ptr<KittiDataset> open_kitti_dataset(const std::string& directory,
     const std::string left = (dir / "image_0" / image_name(i)).string();
     const std::string right = stereo ? (dir / "image_1" / image_name(i)).string() : std::string();
     const int line = entries[i].line;
-    require_listed_file(left, times, line);
-    if (stereo) require_listed_file(right, times, line);
+    require_listed_file(left, times, line, options.missing_images_ok);
+    if (stereo) require_listed_file(right, times, line, options.missing_images_ok);
     c.frames.push_back({i, stamps[i], left, {}, right});
   }
   c.colour_entries = stamps.size();

@@ -180,6 +180,11 @@ std::optional<int> SettingsReader::integer(const std::string& key) const {
 }
 
 std::optional<bool> SettingsReader::flag(const std::string& key) const {
+  if (has(key) && !node(key).isReal() && !node(key).isInt()) {
+    const cv::FileNode n = node(key);
+    fail(key, "expected 0 or 1 (off or on), got " +
+                  (n.isString() ? "'" + clip_text(static_cast<std::string>(n), 60) + "'" : std::string("a non-number")));
+  }
   const auto value = integer(key);
   if (!value) return std::nullopt;
   if (*value != 0 && *value != 1) fail(key, "expected 0 or 1, got " + std::to_string(*value));

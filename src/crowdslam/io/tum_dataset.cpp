@@ -22,10 +22,10 @@ std::vector<double> stamps_of(const std::vector<ListEntry>& entries) {
 
 // Every listed file must exist (even ones left unpaired): replaces each entry's name by its full path.
 std::vector<ListEntry> resolved(const std::string& directory, std::vector<ListEntry> entries,
-                                const std::string& list) {
+                                const std::string& list, bool missing_ok) {
   for (auto& entry : entries) {
     entry.file = (fs::path(directory) / entry.file).string();
-    require_listed_file(entry.file, list, entry.line);
+    require_listed_file(entry.file, list, entry.line, missing_ok);
   }
   return entries;
 }
@@ -55,13 +55,13 @@ std::unique_ptr<Dataset> open_tum_dataset(const std::string& directory, const Da
   c.layout = "tum";
   const std::string rgb_list = (fs::path(directory) / "rgb.txt").string();
   const std::string depth_list = (fs::path(directory) / "depth.txt").string();
-  const auto colour = resolved(directory, read_tum_list(rgb_list), rgb_list);
+  const auto colour = resolved(directory, read_tum_list(rgb_list), rgb_list, options.missing_images_ok);
   c.colour_entries = colour.size();
   const auto colour_kept = without_duplicate_stamps(colour, rgb_list);
   std::error_code ec;
   if (fs::exists(depth_list, ec)) {
     c.sensor = SensorKind::kRgbd;
-    const auto depth = resolved(directory, read_tum_list(depth_list), depth_list);
+    const auto depth = resolved(directory, read_tum_list(depth_list), depth_list, options.missing_images_ok);
     c.depth_entries = depth.size();
     const auto depth_kept = without_duplicate_stamps(depth, depth_list);
     const auto pairs =

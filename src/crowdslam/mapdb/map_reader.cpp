@@ -1,4 +1,5 @@
 // read_map_header(), read_map_info(), load_map(): checks first, then the map objects.
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <system_error>
@@ -6,27 +7,41 @@
 
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/mapdb/map_checks.h"
 #include "crowdslam/mapdb/map_database.h"
 #include "crowdslam/mapdb/metadata.h"
 #include "crowdslam/mapdb/schema.h"
 #include "crowdslam/mapdb/sqlite.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::mapdb {
 
 namespace {
 
-// Opens an existing file and checks that it is a complete map database of a schema we read.
+std::map<std::string, std::string> metadata_rows(Database& db);
+
+// Opens an existing file and checks that it is a complete map database of a schema we read, whose rows
+// hold what they should (map_checks.h).
 Database open_checked(const std::filesystem::path& path) {
   std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
+  const auto status = std::filesystem::status(path, error);
+  if (error || status.type() == std::filesystem::file_type::not_found) {
     throw InputError(path.string() + ": no such map file");
   }
+  if (status.type() == std::filesystem::file_type::directory) throw InputError(path.string() + ": is a directory, not a map file");
+  if (status.type() != std::filesystem::file_type::regular) throw InputError(path.string() + ": not a regular file");
   Database db(path.string(), Database::Mode::kReadOnly);
   {
     auto check = db.prepare("PRAGMA quick_check");
-    const std::string result = check.step() ? check.text(0) : std::string("no answer");
-    if (result != "ok") throw InputError(path.string() + ": the map database is corrupt: " + result);
+    std::string result = check.step() ? check.text(0) : std::string("no answer");
+    if (result != "ok") {
+      // SQLite's report spans lines ("*** in database main ***\nPage 3: ..."): one line, clipped.
+      for (char& c : result) {
+        if (c == '\n' || c == '\r') c = ' ';
+      }
+      throw InputError(path.string() + ": the map database is corrupt: " + clip_text(result, 200));
+    }
   }
   if (!db.has_table("schema_version")) {
     throw InputError(path.string() + ": not a crowdslam map (no schema_version table)");
@@ -42,6 +57,8 @@ Database open_checked(const std::filesystem::path& path) {
   for (size_t i = 0; i < kNumTables; ++i) {
     if (!db.has_table(kTables[i])) throw InputError(path.string() + ": table " + kTables[i] + " missing");
   }
+  check_map_rows(db);
+  checked_next_ids(db, metadata_rows(db));
   return db;
 }
 
@@ -77,12 +94,16 @@ int32_t get_i32(const uint8_t* p) {
 }
 
 std::shared_ptr<map::FrameFeatures> read_features(const Database& db, const Statement& row, uint64_t id,
-                                                  const geometry::PinholeCamera& camera,
+                                                  const geometry::PinholeCamera& camera, int levels,
                                                   const bow::Vocabulary* vocabulary) {
-  const auto n = static_cast<size_t>(row.integer(11));
-  if (row.blob_bytes(12) != n * kKeypointRecordBytes || row.blob_bytes(13) != n * kDescriptorBytes) {
+  // Sizes by division, never by multiplying a stored count (which could wrap around).
+  const int64_t count = row.integer(11);
+  const size_t key_bytes = row.blob_bytes(12);
+  if (count < 0 || key_bytes % kKeypointRecordBytes != 0 || key_bytes / kKeypointRecordBytes != static_cast<uint64_t>(count) ||
+      row.blob_bytes(13) % kDescriptorBytes != 0 || row.blob_bytes(13) / kDescriptorBytes != static_cast<uint64_t>(count)) {
     corrupt(db, "keyframe " + std::to_string(id) + ": keypoint or descriptor blob of the wrong size");
   }
+  const auto n = static_cast<size_t>(count);
   auto f = std::make_shared<map::FrameFeatures>();
   f->keys.resize(n);
   f->keys_un.resize(n);
@@ -91,6 +112,15 @@ std::shared_ptr<map::FrameFeatures> read_features(const Database& db, const Stat
   const auto* p = static_cast<const uint8_t*>(row.blob_data(12));
   bool any_right = false;
   for (size_t i = 0; i < n; ++i, p += kKeypointRecordBytes) {
+    for (size_t offset = 0; offset < 36; offset += 4) {
+      if (!std::isfinite(get_f32(p + offset))) {
+        corrupt(db, "keyframe " + std::to_string(id) + ": keypoint " + std::to_string(i) + " holds a non-finite number");
+      }
+    }
+    if (get_i32(p + 36) < 0 || get_i32(p + 36) >= levels) {
+      corrupt(db, "keyframe " + std::to_string(id) + ": keypoint " + std::to_string(i) + ": pyramid level " +
+                      std::to_string(get_i32(p + 36)) + " outside 0-" + std::to_string(levels - 1));
+    }
     cv::KeyPoint u(get_f32(p + 8), get_f32(p + 12), get_f32(p + 16), get_f32(p + 20), get_f32(p + 24),
                    get_i32(p + 36), get_i32(p + 40));
     cv::KeyPoint k = u;
@@ -164,7 +194,7 @@ LoadedMap load_map(const std::filesystem::path& path, const MapIdentity& expecte
       if (std::abs(q.norm() - 1.0) > 1e-6) corrupt(db, "keyframe " + std::to_string(id) + ": pose is not a rotation");
       const auto pose = geometry::SE3::from_unit_quaternion(q, geometry::Vec3(st.real(7), st.real(8), st.real(9)));
       auto kf = std::make_shared<map::KeyFrame>(id, static_cast<uint64_t>(st.integer(1)), st.real(2), camera, levels,
-                                                read_features(db, st, id, *camera, vocabulary), pose);
+                                                read_features(db, st, id, *camera, levels->num_levels, vocabulary), pose);
       if (!st.is_null(10)) parents[id] = st.integer(10);
       by_id[id] = kf;
       loaded.keyframes.push_back(std::move(kf));
@@ -233,12 +263,8 @@ LoadedMap load_map(const std::filesystem::path& path, const MapIdentity& expecte
   }
   for (const auto& kf : loaded.keyframes) map.add_keyframe(kf);
   for (const auto& point : points) map.add_map_point(point);
-  const auto counter = [&](const char* key) {
-    const auto it = rows.find(key);
-    if (it == rows.end()) corrupt(db, std::string("metadata ") + key + " missing");
-    return static_cast<uint64_t>(std::stoull(it->second));
-  };
-  map.restore_id_counters(counter("map.next_keyframe_id"), counter("map.next_map_point_id"));
+  const NextIds next = checked_next_ids(db, rows);
+  map.restore_id_counters(next.keyframe, next.map_point);
   loaded.map_points = points.size();
   return loaded;
 }

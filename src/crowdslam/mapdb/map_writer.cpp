@@ -8,6 +8,7 @@
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/mapdb/map_database.h"
+#include "crowdslam/mapdb/map_target.h"
 #include "crowdslam/mapdb/metadata.h"
 #include "crowdslam/mapdb/schema.h"
 #include "crowdslam/mapdb/sqlite.h"
@@ -135,6 +136,13 @@ void fsync_file(const std::filesystem::path& path) {
 }  // namespace
 
 void save_map(const std::filesystem::path& path, const map::Map& map, const MapHeader& header) {
+  // The caller checked the path (check_map_target) before its work; a special file put there since is
+  // still never replaced.
+  if (path.empty()) throw InputError("cannot save the map: empty path");
+  if (path_kind(path) == PathKind::kNotRegular) {
+    throw InputError(path.string() + ": cannot save the map: not a regular file (refusing to replace it)");
+  }
+  remove_stale_temporaries(path);  // of a save killed with SIGKILL
   const std::filesystem::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
   std::error_code ignored;
   std::filesystem::remove(tmp, ignored);
@@ -173,6 +181,13 @@ void save_map(const std::filesystem::path& path, const map::Map& map, const MapH
     std::filesystem::remove(tmp, ignored);
     temp_files::remove(slot);
     throw InputError(path.string() + ": cannot save the map: " + e.code().message());
+  } catch (const InputError& e) {
+    std::filesystem::remove(tmp, ignored);
+    temp_files::remove(slot);
+    // Errors of the database name the temporary: the user knows the file they asked for.
+    std::string message = e.what();
+    if (message.rfind(tmp.string() + ": ", 0) == 0) message = message.substr(tmp.string().size() + 2);
+    throw InputError(path.string() + ": cannot save the map: " + message);
   } catch (...) {
     std::filesystem::remove(tmp, ignored);
     temp_files::remove(slot);

@@ -1,9 +1,12 @@
 #include "crowdslam/mapdb/metadata.h"
 
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/text.h"
 
 namespace crowdslam::mapdb {
 
@@ -19,25 +22,31 @@ class Reader {
   Reader(const std::map<std::string, std::string>& rows, const std::string& path) : rows_(rows), path_(path) {}
   [[nodiscard]] const std::string& text(const std::string& key) const {
     const auto it = rows_.find(key);
-    if (it == rows_.end()) throw InputError(path_ + ": metadata: " + key + " missing");
+    if (it == rows_.end()) fail(key, "missing");
     return it->second;
   }
-  [[nodiscard]] double real(const std::string& key) const {
+  // A finite number within [low, high].
+  [[nodiscard]] double real(const std::string& key, double low = -1e300, double high = 1e300) const {
     const std::string& value = text(key);
     char* end = nullptr;
     const double parsed = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0') throw InputError(path_ + ": metadata: " + key + " is not a number: " + value);
+    if (value.empty() || std::isspace(static_cast<unsigned char>(value.front())) || *end != '\0' ||
+        !std::isfinite(parsed)) {
+      fail(key, "is not a finite number: " + clip_text(value, 60));
+    }
+    if (parsed < low || parsed > high) fail(key, "is out of range: " + clip_text(value, 60));
     return parsed;
   }
-  [[nodiscard]] int integer(const std::string& key) const {
-    const double value = real(key);
-    if (value != static_cast<double>(static_cast<long long>(value))) {
-      throw InputError(path_ + ": metadata: " + key + " is not an integer: " + text(key));
-    }
+  [[nodiscard]] int integer(const std::string& key, int low, int high) const {
+    const double value = real(key, low, high);
+    if (value != std::floor(value)) fail(key, "is not an integer: " + clip_text(text(key), 60));
     return static_cast<int>(value);
   }
 
  private:
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw InputError(path_ + ": corrupt map: metadata " + key + " " + what);
+  }
   const std::map<std::string, std::string>& rows_;
   const std::string& path_;
 };
@@ -88,15 +97,15 @@ MapHeader header_from_metadata(const std::map<std::string, std::string>& rows, c
   c.distortion.p1 = r.real("camera.p1");
   c.distortion.p2 = r.real("camera.p2");
   c.distortion.k3 = r.real("camera.k3");
-  c.width = r.integer("camera.width");
-  c.height = r.integer("camera.height");
+  c.width = r.integer("camera.width", 1, 1 << 16);
+  c.height = r.integer("camera.height", 1, 1 << 16);
   c.bf = r.real("camera.bf");
   id.depth_map_factor = r.real("depth_map_factor");
-  id.orb_features = r.integer("orb.features");
-  id.orb_scale_factor = r.real("orb.scale_factor");
-  id.orb_levels = r.integer("orb.levels");
+  id.orb_features = r.integer("orb.features", 0, 1 << 24);
+  id.orb_scale_factor = r.real("orb.scale_factor", 1.0, 10.0);
+  id.orb_levels = r.integer("orb.levels", 1, 32);
   id.vocabulary_hash = r.text("vocabulary.hash");
-  id.vocabulary_words = static_cast<uint64_t>(r.real("vocabulary.words"));
+  id.vocabulary_words = static_cast<uint64_t>(r.integer("vocabulary.words", 0, 1 << 30));
   header.origin.dataset = r.text("origin.dataset");
   header.origin.created_utc = r.text("origin.created_utc");
   header.origin.crowdslam_version = r.text("origin.crowdslam_version");

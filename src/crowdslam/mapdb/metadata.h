@@ -9,7 +9,7 @@
 namespace crowdslam::mapdb {
 
 std::map<std::string, std::string> header_to_metadata(const MapHeader& header);
-// Throws InputError "PATH: metadata: KEY missing / not a number".
+// Throws InputError "PATH: corrupt map: metadata KEY missing / is not a finite number / is out of range".
 MapHeader header_from_metadata(const std::map<std::string, std::string>& rows, const std::string& path);
 
 }  // namespace crowdslam::mapdb

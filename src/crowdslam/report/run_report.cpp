@@ -21,7 +21,8 @@ std::optional<std::string> write_run_report(const std::filesystem::path& out_dir
       out_dir.string(), error);
   run_document["report_error"] = error;
   try {
-    write_file_atomic(out_dir / "run.json", run_document.dump(1) + "\n");
+    write_file_atomic(out_dir / "run.json",
+                      run_document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   } catch (const std::exception& e) {
     spdlog::warn("run.json not updated with the report error: {}", e.what());
   }

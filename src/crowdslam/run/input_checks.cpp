@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <map>
+
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 
@@ -67,14 +69,40 @@ void check_against_settings(const io::Frame& frame, const io::Settings& settings
 }
 }  // namespace
 
-void check_first_frame(io::FrameSource& source, const io::Settings& settings) {
+void check_detections_file(const std::string& path) {
+  // Only the boxes per frame are counted here (the detector reads and checks the rows, and warns about
+  // the ones it skips, when the system is built; also before any output).
+  std::map<long long, size_t> boxes;
+  const auto lines = read_lines(path);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const auto fields = split_fields(lines[i]);
+    if (fields.empty() || fields[0][0] == '#') continue;
+    const auto frame = parse_int(fields[0]);
+    if (frame && ++boxes[*frame] > kMaxBoxesPerFrame) {
+      throw input_error(clip_text(path), static_cast<int>(i + 1),
+                        "frame " + std::to_string(*frame) + " has more than " + std::to_string(kMaxBoxesPerFrame) +
+                            " person boxes (a detector gives a few hundred at most); refusing the file");
+    }
+  }
+}
+
+void check_first_frame(io::FrameSource& source, const io::Settings& settings, bool skip_bad_frames) {
   auto* dataset = dynamic_cast<io::Dataset*>(&source);
   if (dataset == nullptr || dataset->size() == 0) return;
-  io::Frame frame{dataset->frame_info(0), dataset->load(0)};
+  io::Frame frame{dataset->frame_info(0), {}};
+  try {
+    frame.images = dataset->load(0);
+  } catch (const InputError&) {
+    // With --skip-bad-frames an unreadable first frame is skipped like any other; the first frame read
+    // is checked against the settings by InputMonitor.
+    if (skip_bad_frames) return;
+    throw;
+  }
   check_against_settings(frame, settings);
 }
 
 void InputMonitor::check_frame(const io::Frame& frame) {
+  check_timestamp(frame);
   const cv::Size size = frame.images.colour.size();
   if (!first_size_) {
     check_against_settings(frame, settings_);
@@ -94,6 +122,19 @@ void InputMonitor::check_frame(const io::Frame& frame) {
   }
 }
 
+void InputMonitor::check_timestamp(const io::Frame& frame) {
+  const double stamp = frame.info.timestamp_s;
+  if (previous_stamp_s_ && stamp <= *previous_stamp_s_) {
+    if (backwards_++ == 0) {
+      first_backwards_ = frame_name(frame);
+      spdlog::warn("{}: timestamp {:.6f} is not after the previous frame's ({:.6f}); frames are taken in the "
+                   "order listed (is the list reversed or unsorted?)",
+                   first_backwards_, stamp, *previous_stamp_s_);
+    }
+  }
+  previous_stamp_s_ = stamp;
+}
+
 void InputMonitor::after_tracking(const io::Frame& frame, int keypoints) {
   if (keypoints >= kFeaturelessKeypoints) return;
   if (featureless_++ == 0) {
@@ -107,6 +148,9 @@ void InputMonitor::warn_totals() const {
     spdlog::warn("{} frames had fewer than {} ORB keypoints (first: {})", featureless_, kFeaturelessKeypoints,
                  first_featureless_);
   }
+  if (backwards_ > 1) {
+    spdlog::warn("{} frames had a timestamp not after the previous frame's (first: {})", backwards_, first_backwards_);
+  }
   if (empty_depth_ > 1) {
     spdlog::warn("{} frames had no valid depth at all (first: {})", empty_depth_, first_empty_depth_);
   }
@@ -116,6 +160,7 @@ nlohmann::json InputMonitor::to_json() const {
   return {{"featureless_frames", featureless_},
           {"first_featureless_frame", first_featureless_.empty() ? nlohmann::json(nullptr) : nlohmann::json(first_featureless_)},
           {"empty_depth_frames", empty_depth_},
+          {"timestamps_not_increasing", backwards_},
           {"first_empty_depth_frame", first_empty_depth_.empty() ? nlohmann::json(nullptr) : nlohmann::json(first_empty_depth_)}};
 }
 

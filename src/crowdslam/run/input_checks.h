@@ -27,16 +27,25 @@ void check_requested_sensor(const io::FrameSource& source, const std::optional<i
 io::SensorKind choose_sensor(const io::FrameSource& source, const io::Settings& settings,
                              const std::optional<io::SensorKind>& requested);
 
+// The most person boxes one frame of a --detections file may have. A detector gives a few hundred at
+// most; tens of thousands make the per-frame box work (non-maximum suppression) take minutes.
+constexpr size_t kMaxBoxesPerFrame = 2000;
+
+// Before any output exists: reads a --detections file (InputError naming FILE:LINE for a bad row, or a
+// frame with more than kMaxBoxesPerFrame boxes).
+void check_detections_file(const std::string& path);
+
 // Before any output exists: the first frame of a dataset on disk is read and its size compared with
 // Camera.width/height (videos and cameras are checked at their first frame by InputMonitor).
-void check_first_frame(io::FrameSource& source, const io::Settings& settings);
+void check_first_frame(io::FrameSource& source, const io::Settings& settings, bool skip_bad_frames = false);
 
 class InputMonitor {
  public:
   InputMonitor(const io::Settings& settings, io::SensorKind sensor) : settings_(settings), sensor_(sensor) {}
 
   // Before tracking a frame: throws InputError for an image of the wrong size (naming the file, both
-  // sizes and the settings file); counts RGB-D frames without depth.
+  // sizes and the settings file); counts RGB-D frames without depth and warns (once, then in the totals)
+  // about a timestamp that is not after the previous frame's.
   void check_frame(const io::Frame& frame);
   // After tracking it: counts frames whose image gave (almost) no ORB keypoints.
   void after_tracking(const io::Frame& frame, int keypoints);
@@ -53,6 +62,10 @@ class InputMonitor {
   std::string first_path_;
   size_t featureless_ = 0;
   std::string first_featureless_;
+  void check_timestamp(const io::Frame& frame);
+  std::optional<double> previous_stamp_s_;
+  size_t backwards_ = 0;
+  std::string first_backwards_;
   size_t empty_depth_ = 0;
   std::string first_empty_depth_;
 };

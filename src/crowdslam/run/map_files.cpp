@@ -6,6 +6,7 @@
 #include <ctime>
 #include <filesystem>
 
+#include "crowdslam/mapdb/map_target.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 #include "crowdslam/util/version.h"
@@ -26,16 +27,19 @@ void check_map_options(const RunOptions& options) {
   if (options.localization && !options.save_map.empty()) {
     throw InputError("--save-map with --localization: a localisation run does not change the map, nothing to save");
   }
-  if (!options.save_map.empty()) {
-    const std::filesystem::path path(options.save_map);
-    const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  // Only a new file, or (with --overwrite) a crowdslam map, is replaced: never a device, a FIFO, a
+  // settings file or a dataset's list (mapdb/map_target.h).
+  if (options.save_map_given || !options.save_map.empty()) {
+    mapdb::check_map_target(options.save_map, options.overwrite, "--save-map");
+    // Nor one of the run's own outputs, written after the map.
     std::error_code ec;
-    if (!std::filesystem::is_directory(dir, ec)) {
-      throw InputError("--save-map " + clip_text(options.save_map) + ": directory " + clip_text(dir.string()) +
-                       " does not exist");
-    }
-    if (std::filesystem::is_directory(path, ec)) {
-      throw InputError("--save-map " + clip_text(options.save_map) + ": is a directory");
+    const auto map_path = std::filesystem::weakly_canonical(options.save_map, ec);
+    const auto out = std::filesystem::weakly_canonical(options.out_dir, ec);
+    for (const char* name : {"run.json", "CameraTrajectory.txt", "KeyFrameTrajectory.txt", "BridgedTrajectory.txt",
+                             "report.html", "frames"}) {
+      if (!ec && map_path == out / name) {
+        throw InputError("--save-map " + clip_text(options.save_map) + ": is one of the run's outputs in --out");
+      }
     }
   }
 }

@@ -12,7 +12,8 @@
 namespace crowdslam::run {
 
 // Throws InputError for option combinations that cannot work (--localization without --load-map,
-// --save-map with --localization, a --save-map directory that does not exist).
+// --save-map with --localization, a --save-map directory that does not exist, a --save-map path that is
+// empty, a special file, a file that is not a crowdslam map, or a map without --overwrite).
 void check_map_options(const RunOptions& options);
 
 // Loads options.load_map into `slam` when given; returns the run.json "map" object so far (null if no

@@ -81,7 +81,9 @@ struct Prepared {
 
 Prepared prepare(const RunOptions& options) {
   Prepared p;
-  p.source = io::open_source(options.dataset);
+  io::DatasetOptions dataset_options;
+  dataset_options.missing_images_ok = options.skip_bad_frames;  // skipped like any unreadable frame
+  p.source = io::open_source(options.dataset, dataset_options);
   if (const auto frames = p.source->summary().frames; frames && *frames == 0) {
     throw InputError(clip_text(options.dataset) + ": no frames");
   }
@@ -135,7 +137,8 @@ Prepared prepare(const RunOptions& options) {
     p.run_settings.ground.enabled = options.ground == "on";
   }
   if (p.sensor == io::SensorKind::kStereo) prepare_stereo_settings(*p.source, p.run_settings);
-  check_first_frame(*p.source, p.settings);
+  if (!options.detections_file.empty()) check_detections_file(options.detections_file);
+  check_first_frame(*p.source, p.settings, options.skip_bad_frames);
   return p;
 }
 
@@ -146,7 +149,8 @@ void write_final_outputs(const std::filesystem::path& out, const system::System&
   // Frames bridged while people hid the view: not tracked, so never in CameraTrajectory.txt.
   const io::Trajectory bridged = slam.bridged_trajectory();
   if (!bridged.empty()) io::write_trajectory((out / "BridgedTrajectory.txt").string(), bridged, format);
-  write_file_atomic(out / "run.json", doc.dump(1) + "\n");
+  // Replaced, never thrown: a path or an error message may hold bytes that are not UTF-8.
+  write_file_atomic(out / "run.json", doc.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 // What the progress line shows after the counts: state, tracked frames, keyframes, map points, people.
@@ -156,6 +160,14 @@ std::string progress_detail(const system::System& slam, const system::FrameRepor
                 tracking::to_string(report.state), slam.tracked_frames(), slam.num_keyframes(),
                 slam.num_map_points(), 100.0 * report.people_area);
   return detail;
+}
+// A signal after the last frame (while the threads stop or the map is saved) still ends the run as
+// interrupted: it was asked to stop, and run.json and the exit code say so.
+void note_late_signal(system::EndState& end) {
+  if (!end.completed() || interrupt_signal() == 0) return;
+  end.kind = system::EndState::Kind::kInterrupted;
+  end.signal = interrupt_signal();
+  spdlog::warn("run interrupted by {} after its last frame; writing the outputs", signal_name(end.signal));
 }
 }  // namespace
 
@@ -172,6 +184,7 @@ RunSummary run_sequence(const RunOptions& options) {
     viewer_options.port = options.viewer_port;
     viewer_options.ground_truth = p.source->ground_truth();
     viewer_options.monocular = p.sensor == io::SensorKind::kMonocular;
+    viewer_options.pause_timeout_s = options.viewer_pause_timeout_s;
     viewer = std::make_unique<ViewerSession>(viewer_options);
   }
 
@@ -190,7 +203,9 @@ RunSummary run_sequence(const RunOptions& options) {
   journal_options.flush_every_poses = options.journal_flush_frames;
   std::unique_ptr<journal::RunJournal> journal_ptr;
   try {
-    write_file_atomic(out / "run.json", running_document(options, p.settings_path, p.sensor).dump(1) + "\n");
+    write_file_atomic(out / "run.json", running_document(options, p.settings_path, p.sensor)
+                                            .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                                            "\n");
     journal_ptr = std::make_unique<journal::RunJournal>(journal_options);
   } catch (...) {  // nothing was run yet: leave nothing behind
     if (created) {
@@ -203,6 +218,7 @@ RunSummary run_sequence(const RunOptions& options) {
   journal::RunJournal& journal = *journal_ptr;
   slam.add_observer(&journal);
   if (viewer) slam.add_observer(&viewer->observer());
+  for (auto* observer : options.observers) slam.add_observer(observer);
 
   InputMonitor monitor(p.run_settings, p.sensor);
   std::vector<system::FrameReport> reports;
@@ -227,7 +243,8 @@ RunSummary run_sequence(const RunOptions& options) {
         break;
       }
       if (viewer) {
-        viewer->wait_while_paused();
+        const auto paused = viewer->wait_while_paused();
+        if (pacer) pacer->shift(paused);  // a pause stops the sensor's clock too
         viewer->set_progress(reports.size(), false);
         if (interrupt_signal()) continue;  // handled at the top of the loop
       }
@@ -260,6 +277,9 @@ RunSummary run_sequence(const RunOptions& options) {
   progress.finish(reports.size(), reports.empty() ? std::string() : progress_detail(slam, reports.back()));
   const double wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
   prefetcher.cancel();
+  // From here the outputs are written: a second signal no longer exits at once, which would leave run.json
+  // "running" (a third one does).
+  const FinishingScope finishing;
   slam.finish(end);  // stops the threads; the journal drains and closes
   if (end.kind != system::EndState::Kind::kFailed) {
     try {
@@ -279,6 +299,7 @@ RunSummary run_sequence(const RunOptions& options) {
     viewer->stop();
   }
   add_localization_stats(reports, map_json);
+  note_late_signal(end);
   try {
     save_map_if_requested(options, slam, end.to_string(), map_json);
   } catch (const std::exception& e) {
@@ -308,6 +329,7 @@ RunSummary run_sequence(const RunOptions& options) {
         "translates, not only rotates)",
         clip_text(options.dataset), summary.frames);
   }
+  note_late_signal(end);
   const bool untracked = end.completed() && summary.tracked == 0 && !options.allow_untracked;
   if (untracked) {
     end.kind = system::EndState::Kind::kFailed;

@@ -64,11 +64,16 @@ struct RunOptions {
   std::string load_map;
   bool localization = false;
   std::string save_map;
+  bool save_map_given = false;  // --save-map given (an empty path is then an error, not "no map")
   // --viewer: a live web viewer during the run (docs/VIEWER.md), on viewer_host:viewer_port (0: any
   // free port; the URL is printed).
   bool viewer = false;
   std::string viewer_host = "127.0.0.1";
   int viewer_port = 8080;
+  double viewer_pause_timeout_s = 60;  // a pause with no page connected resumes after this (0: never)
+  // Further observers of the run (called on the tracking thread, after the journal and the viewer; they
+  // must outlive the call).
+  std::vector<system::RunObserver*> observers;
 };
 
 // Accuracy of one trajectory (a map segment) against the ground truth.

@@ -18,6 +18,11 @@ class SensorPacer {
   // true: process the frame (after sleeping until its arrival); false: it is stale, drop it.
   bool admit(double stamp_s);
   [[nodiscard]] size_t dropped() const { return dropped_; }
+  // The replay was paused for `paused` (the viewer's pause): the sensor's clock stops too, so frames
+  // after the pause arrive as late as the pause was long, and none is dropped for it.
+  void shift(Clock::duration paused) {
+    if (start_) *start_ += paused;
+  }
 
  private:
   std::optional<Clock::time_point> start_;

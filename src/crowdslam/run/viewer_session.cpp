@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <iostream>
+
 #include "crowdslam/util/interrupt.h"
 
 namespace crowdslam::run {
@@ -19,13 +21,31 @@ ViewerSession::ViewerSession(const ViewerSessionOptions& options) {
            (control_.paused() ? "true" : "false") + ",\"finished\":" + (finished_ ? "true" : "false") + "}";
   });
   server_->start();
-  spdlog::info("viewer: {} (unauthenticated; bound to {})", server_->url(), options.host);
+  pause_timeout_s_ = options.pause_timeout_s;
+  // A result, not a log line: printed whatever the log level (--quiet hides info).
+  std::cerr << "viewer: " << server_->url() << " (unauthenticated; bound to " << options.host << ")" << std::endl;
+  if (!is_loopback_host(options.host)) {
+    spdlog::warn("viewer: listening on {}, not a loopback address: anyone who can reach it can watch and pause "
+                 "this run (no authentication)",
+                 options.host);
+  }
+}
+
+bool is_loopback_host(const std::string& host) {
+  return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
 }
 
 ViewerSession::~ViewerSession() { stop(); }
 
-void ViewerSession::wait_while_paused() {
-  control_.wait_while_paused([] { return interrupted(); });
+std::chrono::steady_clock::duration ViewerSession::wait_while_paused() {
+  const auto timeout = std::chrono::milliseconds(static_cast<long long>(pause_timeout_s_ * 1000.0));
+  const auto wait = control_.wait_while_paused([] { return interrupted(); }, [this] { return stream_.clients(); },
+                                               timeout);
+  if (wait.idle_resumed) {
+    spdlog::warn("viewer: the run was paused with no viewer connected for {} s; resuming (--viewer-pause-timeout)",
+                 pause_timeout_s_);
+  }
+  return wait.paused;
 }
 
 void ViewerSession::set_progress(size_t frames, bool finished) {

@@ -1,6 +1,7 @@
 #include "crowdslam/util/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -23,6 +24,48 @@ std::string sync_path(const std::filesystem::path& path, bool directory) {
 }
 }  // namespace
 
+namespace detail {
+bool FdStreamBuf::write_all(const char* data, size_t n) {
+  while (n > 0 && error_ == 0) {
+    const ssize_t written = ::write(fd_, data, n);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      error_ = errno;
+      return false;
+    }
+    data += written;
+    n -= static_cast<size_t>(written);
+  }
+  return error_ == 0;
+}
+
+bool FdStreamBuf::flush_buffer() {
+  const auto n = static_cast<size_t>(pptr() - pbase());
+  const bool ok = error_ == 0 && write_all(pbase(), n);
+  setp(buffer_.data(), buffer_.data() + buffer_.size());
+  return ok;
+}
+
+FdStreamBuf::int_type FdStreamBuf::overflow(int_type c) {
+  if (!flush_buffer()) return traits_type::eof();
+  if (!traits_type::eq_int_type(c, traits_type::eof())) {
+    *pptr() = traits_type::to_char_type(c);
+    pbump(1);
+  }
+  return traits_type::not_eof(c);
+}
+
+std::streamsize FdStreamBuf::xsputn(const char* data, std::streamsize n) {
+  if (n <= epptr() - pptr()) {
+    std::memcpy(pptr(), data, static_cast<size_t>(n));
+    pbump(static_cast<int>(n));
+    return n;
+  }
+  if (!flush_buffer() || !write_all(data, static_cast<size_t>(n))) return 0;
+  return n;
+}
+}  // namespace detail
+
 AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
   tmp_path_ = path_;
   tmp_path_ += ".tmp." + std::to_string(::getpid());
@@ -30,18 +73,26 @@ AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
   if (path_.has_parent_path() && !std::filesystem::is_directory(path_.parent_path(), ec)) {
     throw input_error(path_.string(), "output directory does not exist");
   }
+  // Renaming over a device, FIFO, socket or directory would replace it (as root, /dev/null itself).
+  const auto type = std::filesystem::symlink_status(path_, ec).type();
+  if (!ec && type != std::filesystem::file_type::not_found && type != std::filesystem::file_type::regular &&
+      type != std::filesystem::file_type::symlink) {
+    throw input_error(path_.string(), "exists and is not a regular file (a directory, device, FIFO or socket); "
+                                      "refusing to replace it");
+  }
   registry_slot_ = temp_files::add(tmp_path_.string());
-  out_.open(tmp_path_, std::ios::out | std::ios::trunc | std::ios::binary);
-  if (!out_) {
+  fd_ = ::open(tmp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
     const int saved = errno;
     temp_files::remove(registry_slot_);
     throw input_error(path_.string(), std::string("cannot open for writing: ") + std::strerror(saved));
   }
+  buffer_.attach(fd_);
 }
 
 AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
   if (!committed_) {
-    out_.close();
     std::error_code ec;
     std::filesystem::remove(tmp_path_, ec);
   }
@@ -49,18 +100,21 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
-  errno = 0;
   out_.flush();
-  const bool good = static_cast<bool>(out_);
-  const int saved = errno;
-  out_.close();
-  if (!good || !out_) {
-    throw input_error(path_.string(), std::string("write failed") + (saved ? std::string(": ") + std::strerror(saved) : ""));
+  const bool good = static_cast<bool>(out_) && buffer_.error() == 0;
+  if (!good) {
+    const int saved = buffer_.error();
+    throw input_error(path_.string(), std::string("write failed: ") +
+                                          (saved ? std::strerror(saved) : "the output stream failed"));
   }
   // Durable before it replaces anything: the data first, then the rename, then the directory entry.
-  if (const auto error = sync_path(tmp_path_, false); !error.empty()) {
-    throw input_error(path_.string(), "cannot sync to disk: " + error);
-  }
+  const int sync_rc = ::fsync(fd_);
+  const int sync_error = errno;
+  const int close_rc = ::close(fd_);
+  const int close_error = errno;
+  fd_ = -1;
+  if (sync_rc != 0) throw input_error(path_.string(), std::string("cannot sync to disk: ") + std::strerror(sync_error));
+  if (close_rc != 0) throw input_error(path_.string(), std::string("write failed: ") + std::strerror(close_error));
   std::error_code ec;
   std::filesystem::rename(tmp_path_, path_, ec);
   if (ec) throw input_error(path_.string(), "cannot rename temporary file: " + ec.message());
@@ -77,6 +131,26 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
 void remove_quietly(const std::filesystem::path& path) {
   std::error_code ec;
   std::filesystem::remove_all(path, ec);
+}
+
+size_t remove_stale_temporaries(const std::filesystem::path& path) {
+  const std::string prefix = path.filename().string() + ".tmp.";
+  const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  size_t removed = 0;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const auto pid = static_cast<pid_t>(std::stol(digits));
+    if (pid <= 0 || pid == ::getpid()) continue;
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // that process still runs (or is not ours to judge)
+    std::error_code ignored;
+    if (it->symlink_status(ignored).type() != std::filesystem::file_type::regular) continue;
+    if (std::filesystem::remove(it->path(), ignored)) ++removed;
+  }
+  return removed;
 }
 
 void sync_directory(const std::filesystem::path& directory) { (void)sync_path(directory, true); }

@@ -23,6 +23,8 @@ std::array<Slot, kSlots> g_slots;
 
 std::atomic<int> g_signal{0};
 std::atomic<bool> g_cooperative{false};
+std::atomic<bool> g_finishing{false};
+std::atomic<int> g_extra_signals{0};  // signals after the first, while finishing
 
 void unlink_registered() {
   for (auto& slot : g_slots) {
@@ -54,10 +56,16 @@ extern "C" void on_signal(int signal) {
     if (g_signal.compare_exchange_strong(expected, signal)) {
       write_stderr("\ninterrupted (");
       write_stderr(name_of(signal));
-      write_stderr("): stopping and writing the outputs; send it again to exit at once\n");
+      write_stderr(g_finishing.load() ? "): writing the outputs; send it twice more to exit at once\n"
+                                      : "): stopping and writing the outputs; send it again to exit at once\n");
       return;
     }
-    // Second signal: leave at once.
+    if (g_finishing.load() && g_extra_signals.fetch_add(1) == 0) {
+      write_stderr("\nstill writing the outputs (run.json, the map); send it once more to exit at once, "
+                   "leaving them incomplete\n");
+      return;
+    }
+    // Second signal (third while finishing): leave at once.
     unlink_registered();
     _exit(128 + signal);
   }
@@ -85,6 +93,13 @@ InterruptScope::InterruptScope() {
 }
 
 InterruptScope::~InterruptScope() { install(false); }
+
+FinishingScope::FinishingScope() {
+  g_extra_signals.store(0);
+  g_finishing.store(true);
+}
+
+FinishingScope::~FinishingScope() { g_finishing.store(false); }
 
 int interrupt_signal() { return g_signal.load(); }
 

@@ -28,6 +28,17 @@ class InterruptScope {
   InterruptScope& operator=(const InterruptScope&) = delete;
 };
 
+// While alive (inside an InterruptScope: a command writing its final outputs, e.g. run.json and the
+// saved map), a second signal does not exit at once, which would leave run.json saying "running": it
+// only says the outputs are being written, and a third signal exits at once.
+class FinishingScope {
+ public:
+  FinishingScope();
+  ~FinishingScope();
+  FinishingScope(const FinishingScope&) = delete;
+  FinishingScope& operator=(const FinishingScope&) = delete;
+};
+
 // The first signal received inside an InterruptScope (SIGINT, SIGTERM, SIGHUP), or 0.
 int interrupt_signal();
 inline bool interrupted() { return interrupt_signal() != 0; }

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "crowdslam/util/error.h"
@@ -47,16 +49,49 @@ std::optional<long long> parse_int(std::string_view text) {
   return value;
 }
 
-std::vector<std::string> read_lines(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw input_error(path, "cannot open file");
+void check_regular_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (status.type() == std::filesystem::file_type::not_found) throw input_error(clip_text(path), "no such file");
+  if (status.type() == std::filesystem::file_type::directory) throw input_error(clip_text(path), "is a directory, not a file");
+  if (ec || status.type() != std::filesystem::file_type::regular) {
+    throw input_error(clip_text(path), "not a regular file (a device, FIFO or socket is not read)");
+  }
+}
+
+std::vector<std::string> read_lines(const std::string& path, size_t max_line_bytes) {
+  check_regular_file(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw input_error(clip_text(path), std::string("cannot open file: ") + std::strerror(errno));
   std::vector<std::string> lines;
   std::string line;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::string chunk(1 << 16, '\0');
+  // Read in blocks: a line longer than the limit (a file of zeros, a binary file) is refused before it
+  // fills memory.
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    const auto got = static_cast<size_t>(in.gcount());
+    size_t start = 0;
+    for (size_t i = 0; i < got; ++i) {
+      if (chunk[i] != '\n') continue;
+      line.append(chunk, start, i - start);
+      start = i + 1;
+      if (line.size() > max_line_bytes) break;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      lines.push_back(std::move(line));
+      line.clear();
+    }
+    if (line.size() <= max_line_bytes) line.append(chunk, start, got - start);
+    if (line.size() > max_line_bytes) {
+      throw input_error(clip_text(path), static_cast<int>(lines.size() + 1),
+                        "line longer than " + std::to_string(max_line_bytes) + " bytes (not a text file?)");
+    }
+  }
+  if (in.bad()) throw input_error(clip_text(path), std::string("read error: ") + std::strerror(errno));
+  if (!line.empty()) {
+    if (line.back() == '\r') line.pop_back();
     lines.push_back(std::move(line));
   }
-  if (in.bad()) throw input_error(path, "read error");
   return lines;
 }
 

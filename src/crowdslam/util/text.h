@@ -14,8 +14,15 @@ std::vector<std::string> split_fields(std::string_view line, bool commas_too = t
 std::optional<double> parse_double(std::string_view text);
 std::optional<long long> parse_int(std::string_view text);
 
-// Reads a whole text file into lines (without '\n'); throws InputError naming the file if unreadable.
-std::vector<std::string> read_lines(const std::string& path);
+// Throws InputError "PATH: no such file / is a directory, not a file / not a regular file" unless `path`
+// names a regular file (after links): a device (/dev/zero), FIFO or socket is never read.
+void check_regular_file(const std::string& path);
+
+// Reads a whole text file into lines (without '\n' and a trailing '\r'); throws InputError naming the
+// file if it is not a regular file or unreadable, and naming the line if one is longer than
+// `max_line_bytes`.
+constexpr size_t kMaxLineBytes = 8 << 20;  // 8 MiB: no text line of ours comes near
+std::vector<std::string> read_lines(const std::string& path, size_t max_line_bytes = kMaxLineBytes);
 
 std::string trim(std::string_view text);
 

@@ -94,6 +94,11 @@ bool EventStream::closed() const {
   return closed_;
 }
 
+size_t EventStream::clients() const {
+  std::lock_guard lock(mutex_);
+  return clients_;
+}
+
 uint64_t EventStream::published() const {
   std::lock_guard lock(mutex_);
   return sequence_;

@@ -53,6 +53,8 @@ class EventStream {
   void close();
   [[nodiscard]] bool closed() const;
   [[nodiscard]] uint64_t published() const;
+  // Clients registered now (connected event streams).
+  [[nodiscard]] size_t clients() const;
 
  private:
   struct Entry {

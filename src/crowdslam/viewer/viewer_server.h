@@ -1,8 +1,10 @@
 #pragma once
-// The viewer's HTTP server (cpp-httplib) in its own thread: the page, three.js (served from Debian's
-// libjs-three, never a CDN), the Server-Sent Events stream, the run state and the pause/step/resume
-// controls. It serves a fixed list of paths and nothing from the file system, binds to 127.0.0.1 unless
-// told otherwise, and has no authentication (docs/VIEWER.md).
+// The viewer's HTTP server (our own, http_server.h: a thread per connection, bounded requests, capped
+// clients) in its own thread: the page, three.js (served from Debian's libjs-three, never a CDN), the
+// Server-Sent Events stream, the run state and the pause/step/resume controls. It serves a fixed list of
+// paths and nothing from the file system, binds to 127.0.0.1 unless told otherwise, and has no
+// authentication (docs/VIEWER.md). Open event streams and slow clients never block the page, /state or
+// the controls.
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -10,11 +12,8 @@
 #include <thread>
 
 #include "crowdslam/viewer/event_stream.h"
+#include "crowdslam/viewer/http_server.h"
 #include "crowdslam/viewer/run_control.h"
-
-namespace httplib {
-class Server;
-}
 
 namespace crowdslam::viewer {
 
@@ -22,6 +21,7 @@ struct ViewerServerOptions {
   std::string host = "127.0.0.1";
   int port = 8080;         // 0: any free port
   std::string three_dir;   // "" = $CROWDSLAM_THREE_DIR or the Debian path (/usr/share/javascript/three)
+  HttpServerOptions http;  // connection and stream caps, request and write timeouts
   void check() const;      // throws InputError naming the bad option
 };
 
@@ -52,8 +52,7 @@ class ViewerServer {
   EventStream& stream_;
   RunControl* control_;
   std::function<std::string()> state_json_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
+  std::unique_ptr<HttpServer> server_;
   int port_ = 0;
   std::string three_js_, orbit_controls_js_;
   std::string session_;
