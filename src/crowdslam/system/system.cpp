@@ -169,6 +169,7 @@ void System::shutdown() {
   shut_down_ = true;
   mapper_->stop();
   if (loop_closer_) loop_closer_->stop();  // after the mapper: it may still hand over keyframes
+  erase_culled_points();
   if (ground_ && !localization_only()) {  // a map only localised in is left as it was loaded
     // All threads have stopped: the map is final but for this adjustment. Frames follow their keyframes.
     loop::GlobalBundleAdjuster adjuster(map_, nullptr, kFinalGroundBaIterations);
@@ -186,6 +187,13 @@ void System::stop_now() {
   shut_down_ = true;
   mapper_->stop_now();
   if (loop_closer_) loop_closer_->stop_now();
+  erase_culled_points();
+}
+
+void System::erase_culled_points() {
+  // Points tracking culled after the mapper's last pass (the dynamic check) leave the map too, so that
+  // its count, its snapshot and a saved map agree. A map only localised in is left as it was loaded.
+  if (!localization_only()) map_->erase_bad_map_points();
 }
 
 void System::finish(const EndState& end) {

@@ -199,6 +199,7 @@ class System {
   // Takes a MapSnapshot for the observers that want one when their interval has passed (or `force`).
   void publish_map_snapshot(bool force);
   [[nodiscard]] std::shared_ptr<const MapSnapshot> take_map_snapshot() const;
+  void erase_culled_points();  // after the threads stop: bad map points out of the map
   // The record's pose through its reference keyframe (or the stored one).
   [[nodiscard]] geometry::SE3 world_from_cam(const TrajectoryRecord& record) const;
   [[nodiscard]] io::Trajectory live_keyframe_trajectory() const;
