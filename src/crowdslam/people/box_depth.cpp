@@ -150,11 +150,8 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
   // them says so. A wall continuing past the box agrees on every side; a person beside a crate or another
   // person (one side as close as they are) still stands out against the other sides.
   const double scale = 1.0 / std::max(depth_image_raw.cols, depth_image_raw.rows);
-  // The depth the plane through `around` predicts at pixel (u, v) (by default the torso's).
-  auto gap_from = [&](const std::vector<const Patch*>& around, std::optional<cv::Point2d> at = std::nullopt)
-      -> std::optional<double> {
+  auto gap_from = [&](const std::vector<const Patch*>& around) -> std::optional<double> {
     if (around.size() < 3) return std::nullopt;
-    const cv::Point2d where = at.value_or(cv::Point2d(torso.u, torso.v));
     // 1/z = a u + b v + c, least squares over the patches (pixels scaled to ~1 for conditioning).
     Eigen::MatrixXd a(static_cast<Eigen::Index>(around.size()), 3);
     Eigen::VectorXd b(static_cast<Eigen::Index>(around.size()));
@@ -163,9 +160,9 @@ BoxDepthTest box_depth_test(const cv::Mat& depth_image_raw, double depth_factor,
       b(static_cast<Eigen::Index>(i)) = 1.0 / around[i]->depth_m;
     }
     const Eigen::Vector3d plane = a.colPivHouseholderQr().solve(b);
-    const double inverse = plane.dot(Eigen::Vector3d(where.x * scale, where.y * scale, 1.0));
-    // A plane that does not reach the ray in front of the camera: the patches are not one surface
-    // there, nothing to compare with.
+    const double inverse = plane.dot(Eigen::Vector3d(torso.u * scale, torso.v * scale, 1.0));
+    // A plane that does not reach the torso's ray in front of the camera: the surroundings are not one
+    // surface there, nothing to compare with.
     if (!(inverse > 1e-6)) return std::nullopt;
     return 1.0 / inverse;
   };
