@@ -143,3 +143,31 @@ TEST(CliSynthSignals, InterruptedSynthLeavesNoTemporaryDirectory) {
   EXPECT_NE(r.err.find("interrupted"), std::string::npos) << r.err;
   for (const auto& e : std::filesystem::directory_iterator(dir.path())) ADD_FAILURE() << "left behind: " << e.path();
 }
+
+// Issue 37, finding 15: SIGKILL cannot be handled, so its "seq.tmp-<pid>" stays; the next synth to the
+// same place removes it (the killed process no longer runs).
+TEST(CliSynthSignals, TheNextSynthRemovesTheDirectoryOfAKilledOne) {
+  TempDir dir;
+  const auto out = dir / "seq";
+  CliProcess child({"synth", "--out", out.string(), "--frames", "3000", "--width", "320", "--height", "240"});
+  std::filesystem::path left;
+  const bool started = child.wait_until(
+      [&] {
+        for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+          if (e.path().filename().string().find("seq.tmp-") == 0 && std::filesystem::exists(e.path() / "rgb" / "000005.png")) {
+            left = e.path();
+            return true;
+          }
+        }
+        return false;
+      },
+      120);
+  ASSERT_TRUE(started) << child.current_stderr();
+  child.send_signal(SIGKILL);
+  child.wait(60);
+  ASSERT_TRUE(std::filesystem::exists(left));
+  const auto r = run_cli({"synth", "--out", out.string(), "--frames", "3", "--width", "160", "--height", "120"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(left));
+  EXPECT_TRUE(std::filesystem::exists(out / "rgb.txt"));
+}

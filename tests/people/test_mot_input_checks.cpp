@@ -60,5 +60,33 @@ TEST(MotInput, NonIntegerOrHugeIdIsAnErrorNamingTheLine) {
   EXPECT_NE(message.find("det.txt:2: id must be an integer"), std::string::npos) << message;
 }
 
+// Issue 37, finding 7: a frame with more boxes than kMaxBoxesPerFrame keeps its most confident ones (in
+// file order, the first of equal scores first); the rest are counted and warned about once.
+TEST(MotInput, AFrameBeyondTheBoxCapKeepsItsMostConfidentBoxes) {
+  test::TempDir dir;
+  const std::string path = (dir / "det.txt").string();
+  std::string text;
+  const std::size_t weak = 3 * kMaxBoxesPerFrame;
+  for (std::size_t i = 0; i < weak; ++i) text += "1,-1,100,100,20,40,0.5\n";
+  for (std::size_t i = 0; i < kMaxBoxesPerFrame - 10; ++i) text += "1,-1," + std::to_string(i % 50) + ",1,20,40,0.9\n";
+  for (int i = 0; i < 5; ++i) text += "2,-1,1,1,20,40,0.1\n";  // under the cap: all kept, whatever their score
+  test::write_text(path, text);
+  test::LogCapture log;
+  const MotFile file = read_mot_file(path);
+  EXPECT_EQ(file.capped_frames, 1u);
+  EXPECT_EQ(file.dropped_over_cap, weak - 10);
+  ASSERT_EQ(file.rows.size(), kMaxBoxesPerFrame + 5);
+  // The 10 weak boxes kept are the first 10 of the file; then every strong one; then frame 2.
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(file.rows[i].line, static_cast<int>(i + 1));
+  for (std::size_t i = 10; i < kMaxBoxesPerFrame; ++i) EXPECT_DOUBLE_EQ(file.rows[i].score, 0.9);
+  EXPECT_EQ(file.rows.back().frame, 2);
+  const auto warnings = log.warnings();
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("1 frame with more than 2000 person boxes (first: frame 1); kept the 2000 most "
+                             "confident of each, skipped 5990 boxes"),
+            std::string::npos)
+      << warnings[0];
+}
+
 }  // namespace
 }  // namespace crowdslam::people

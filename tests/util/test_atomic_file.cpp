@@ -98,6 +98,27 @@ TEST(AtomicFile, StaleTemporariesOfDeadProcessesAreRemoved) {
   EXPECT_TRUE(std::filesystem::exists(tmp / ("other.db.tmp." + std::to_string(child))));
 }
 
+// Issue 37, finding 15: `synth`'s "<out>.tmp-<pid>" directory of a killed run goes on the next write.
+TEST(AtomicFile, StaleTemporaryDirectoriesOfDeadProcessesAreRemoved) {
+  test::TempDir tmp;
+  const pid_t child = ::fork();
+  if (child == 0) _exit(0);
+  ::waitpid(child, nullptr, 0);
+  const auto dead = tmp / ("seq.tmp-" + std::to_string(child));
+  const auto live = tmp / ("seq.tmp-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dead / "rgb");
+  test::write_text(dead / "rgb" / "0.png", "x");
+  std::filesystem::create_directories(live);
+  test::write_text(tmp / ("file.tmp-" + std::to_string(child)), "a file of that naming is not ours");
+  std::filesystem::create_symlink(dead, tmp / ("seq2.tmp-" + std::to_string(child)));
+  EXPECT_EQ(remove_stale_temporary_dirs(tmp / "file"), 0u);
+  EXPECT_EQ(remove_stale_temporary_dirs(tmp / "seq2"), 0u);
+  EXPECT_EQ(remove_stale_temporary_dirs(tmp / "seq"), 1u);
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(live));
+  EXPECT_TRUE(std::filesystem::exists(tmp / ("file.tmp-" + std::to_string(child))));
+}
+
 // Issue 37, finding 1: an output path naming a device or a FIFO was replaced by the rename.
 TEST(AtomicFile, NeverReplacesASpecialFileOrADirectory) {
   test::TempDir tmp;

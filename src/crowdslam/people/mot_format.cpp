@@ -3,7 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <algorithm>
 #include <sstream>
+#include <unordered_map>
 
 #include "crowdslam/io/input_text.h"
 #include "crowdslam/util/atomic_file.h"
@@ -62,6 +64,33 @@ MotRow parse_row(const std::string& path, int line, const std::vector<std::strin
   return row;
 }
 
+// Keeps the kMaxBoxesPerFrame most confident rows of each frame (rows stay in file order).
+void cap_boxes_per_frame(MotFile& file) {
+  std::unordered_map<int, std::vector<std::size_t>> rows_of;
+  for (std::size_t i = 0; i < file.rows.size(); ++i) rows_of[file.rows[i].frame].push_back(i);
+  std::vector<bool> drop(file.rows.size(), false);
+  int first_frame = 0;
+  for (auto& [frame, rows] : rows_of) {
+    if (rows.size() <= kMaxBoxesPerFrame) continue;
+    std::stable_sort(rows.begin(), rows.end(),
+                     [&](std::size_t a, std::size_t b) { return file.rows[a].score > file.rows[b].score; });
+    for (std::size_t k = kMaxBoxesPerFrame; k < rows.size(); ++k) drop[rows[k]] = true;
+    ++file.capped_frames;
+    file.dropped_over_cap += rows.size() - kMaxBoxesPerFrame;
+    if (first_frame == 0 || frame < first_frame) first_frame = frame;
+  }
+  if (file.capped_frames == 0) return;
+  std::vector<MotRow> kept;
+  kept.reserve(file.rows.size() - file.dropped_over_cap);
+  for (std::size_t i = 0; i < file.rows.size(); ++i)
+    if (!drop[i]) kept.push_back(file.rows[i]);
+  file.rows = std::move(kept);
+  spdlog::warn("{}: {} frame{} with more than {} person boxes (first: frame {}); kept the {} most confident of each, "
+               "skipped {} box{}",
+               clip_text(file.path), file.capped_frames, file.capped_frames == 1 ? "" : "s", kMaxBoxesPerFrame,
+               first_frame, kMaxBoxesPerFrame, file.dropped_over_cap, file.dropped_over_cap == 1 ? "" : "es");
+}
+
 }  // namespace
 
 MotFile read_mot_file(const std::string& path, bool ground_truth) {
@@ -93,6 +122,7 @@ MotFile read_mot_file(const std::string& path, bool ground_truth) {
     }
     file.rows.push_back(row);
   }
+  cap_boxes_per_frame(file);
   if (file.first_dropped_line > 0)
     spdlog::warn(
         "{}:{}: {} box{} skipped: {} with zero or negative width/height, {} with a coordinate or size beyond "

@@ -39,11 +39,18 @@ struct MotFile {
   std::size_t dropped_empty = 0;         // rows dropped for zero / negative width or height
   std::size_t dropped_out_of_range = 0;  // rows dropped for |x|, |y|, w or h > kMaxBoxCoordinate
   int first_dropped_line = 0;            // line of the first dropped row, 0 when none
+  std::size_t capped_frames = 0;         // frames that had more than kMaxBoxesPerFrame boxes
+  std::size_t dropped_over_cap = 0;      // their least confident boxes beyond the cap, dropped
 };
+
+// The most boxes of one frame that are kept. A detector gives a few hundred at most; tens of thousands
+// would make the per-frame box work (suppression, matching, the people filter) take minutes. Beyond it
+// the most confident boxes are kept (file order among equal scores) and the rest counted and warned about.
+constexpr std::size_t kMaxBoxesPerFrame = 2000;
 
 // Reads a MOT file. `ground_truth` = parse columns 8-9 as class and visibility when the file has exactly
 // 9 columns (MOT16/17); a 10-column file (MOT15: x, y, z world coordinates, -1 when unknown) is read
-// with class -1. Throws InputError naming file and line.
+// with class -1. Throws InputError naming file and line. At most kMaxBoxesPerFrame boxes per frame.
 MotFile read_mot_file(const std::string& path, bool ground_truth = false);
 
 // Writes detections as MOT rows "frame,-1,x,y,w,h,conf,-1,-1,-1" (frame = frame_index + 1), atomically.

@@ -2,8 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <map>
-
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 
@@ -68,23 +66,6 @@ void check_against_settings(const io::Frame& frame, const io::Settings& settings
   io::check_image_size(settings, frame.images.colour.size(), frame_name(frame));
 }
 }  // namespace
-
-void check_detections_file(const std::string& path) {
-  // Only the boxes per frame are counted here (the detector reads and checks the rows, and warns about
-  // the ones it skips, when the system is built; also before any output).
-  std::map<long long, size_t> boxes;
-  const auto lines = read_lines(path);
-  for (size_t i = 0; i < lines.size(); ++i) {
-    const auto fields = split_fields(lines[i]);
-    if (fields.empty() || fields[0][0] == '#') continue;
-    const auto frame = parse_int(fields[0]);
-    if (frame && ++boxes[*frame] > kMaxBoxesPerFrame) {
-      throw input_error(clip_text(path), static_cast<int>(i + 1),
-                        "frame " + std::to_string(*frame) + " has more than " + std::to_string(kMaxBoxesPerFrame) +
-                            " person boxes (a detector gives a few hundred at most); refusing the file");
-    }
-  }
-}
 
 void check_first_frame(io::FrameSource& source, const io::Settings& settings, bool skip_bad_frames) {
   auto* dataset = dynamic_cast<io::Dataset*>(&source);

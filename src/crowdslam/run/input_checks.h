@@ -27,14 +27,6 @@ void check_requested_sensor(const io::FrameSource& source, const std::optional<i
 io::SensorKind choose_sensor(const io::FrameSource& source, const io::Settings& settings,
                              const std::optional<io::SensorKind>& requested);
 
-// The most person boxes one frame of a --detections file may have. A detector gives a few hundred at
-// most; tens of thousands make the per-frame box work (non-maximum suppression) take minutes.
-constexpr size_t kMaxBoxesPerFrame = 2000;
-
-// Before any output exists: reads a --detections file (InputError naming FILE:LINE for a bad row, or a
-// frame with more than kMaxBoxesPerFrame boxes).
-void check_detections_file(const std::string& path);
-
 // Before any output exists: the first frame of a dataset on disk is read and its size compared with
 // Camera.width/height (videos and cameras are checked at their first frame by InputMonitor).
 void check_first_frame(io::FrameSource& source, const io::Settings& settings, bool skip_bad_frames = false);

@@ -137,7 +137,9 @@ Prepared prepare(const RunOptions& options) {
     p.run_settings.ground.enabled = options.ground == "on";
   }
   if (p.sensor == io::SensorKind::kStereo) prepare_stereo_settings(*p.source, p.run_settings);
-  if (!options.detections_file.empty()) check_detections_file(options.detections_file);
+  // Refused before the vocabulary loads; its rows are read and checked when the system is built (also
+  // before any output).
+  if (!options.detections_file.empty()) check_regular_file(options.detections_file);
   check_first_frame(*p.source, p.settings, options.skip_bad_frames);
   return p;
 }

@@ -315,6 +315,7 @@ SpriteSet extract_sprites(const std::vector<fs::path>& sequences, const fs::path
   fs::path tmp = out_dir;
   tmp += ".tmp-" + std::to_string(::getpid());
   remove_quietly(tmp);
+  remove_stale_temporary_dirs(out_dir);  // of a run killed with SIGKILL
   try {
     fs::create_directories(tmp, ec);
     if (ec) throw input_error(tmp.string(), "cannot create directory: " + ec.message());

@@ -376,6 +376,7 @@ SequenceSummary write_sequence(const SynthOptions& options, const fs::path& out_
   fs::path tmp = out_dir;
   tmp += ".tmp-" + std::to_string(::getpid());
   remove_quietly(tmp);
+  remove_stale_temporary_dirs(out_dir);  // of a run killed with SIGKILL
   try {
     std::error_code ec;
     fs::create_directories(tmp, ec);

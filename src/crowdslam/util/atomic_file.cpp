@@ -133,8 +133,12 @@ void remove_quietly(const std::filesystem::path& path) {
   std::filesystem::remove_all(path, ec);
 }
 
-size_t remove_stale_temporaries(const std::filesystem::path& path) {
-  const std::string prefix = path.filename().string() + ".tmp.";
+namespace {
+
+// Removes entries "<name><separator><pid>" next to `path` whose process no longer runs. A regular file
+// (dirs = false) or a directory (dirs = true) of exactly that naming; never a symlink or a device.
+size_t remove_stale(const std::filesystem::path& path, const std::string& separator, bool dirs) {
+  const std::string prefix = path.filename().string() + separator;
   const auto dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   size_t removed = 0;
   std::error_code ec;
@@ -147,11 +151,21 @@ size_t remove_stale_temporaries(const std::filesystem::path& path) {
     if (pid <= 0 || pid == ::getpid()) continue;
     if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // that process still runs (or is not ours to judge)
     std::error_code ignored;
-    if (it->symlink_status(ignored).type() != std::filesystem::file_type::regular) continue;
-    if (std::filesystem::remove(it->path(), ignored)) ++removed;
+    const auto type = it->symlink_status(ignored).type();
+    const auto wanted = dirs ? std::filesystem::file_type::directory : std::filesystem::file_type::regular;
+    if (type != wanted) continue;
+    if (dirs ? std::filesystem::remove_all(it->path(), ignored) > 0 : std::filesystem::remove(it->path(), ignored)) {
+      ++removed;
+    }
   }
   return removed;
 }
+
+}  // namespace
+
+size_t remove_stale_temporaries(const std::filesystem::path& path) { return remove_stale(path, ".tmp.", false); }
+
+size_t remove_stale_temporary_dirs(const std::filesystem::path& path) { return remove_stale(path, ".tmp-", true); }
 
 void sync_directory(const std::filesystem::path& directory) { (void)sync_path(directory, true); }
 

@@ -68,6 +68,9 @@ void remove_quietly(const std::filesystem::path& path);
 // runs: left by a writer killed with SIGKILL. Returns how many were removed; never throws.
 size_t remove_stale_temporaries(const std::filesystem::path& path);
 
+// The same for directories "<path>.tmp-<pid>" (a dataset or sprite set being written by `synth`).
+size_t remove_stale_temporary_dirs(const std::filesystem::path& path);
+
 // fsync() of a directory, so renames and new entries in it survive a crash (best effort).
 void sync_directory(const std::filesystem::path& directory);
 
