@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "crowdslam/eval/ate.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
@@ -37,8 +38,10 @@ Blackout make_blackout(const test::TempDir& tmp) {
   return b;
 }
 
-run::RunSummary run_on(const Blackout& b, const std::filesystem::path& out, const std::string& extra = "") {
+run::RunSummary run_on(const Blackout& b, const std::filesystem::path& out, const std::string& extra = "",
+                       std::optional<io::SensorKind> sensor = std::nullopt) {
   run::RunOptions o;
+  o.sensor = sensor;
   o.dataset = b.dir.string();
   o.out_dir = out.string();
   o.sequential = true;
@@ -105,4 +108,47 @@ TEST(RunBlackout, BridgedFramesKeepOneMapAndAreNeverCountedAsTracked) {
   const auto without = run_on(b, tmp / "without", "\nTracking.bridge_max_s: 0\n");
   EXPECT_EQ(without.bridged, 0u);
   EXPECT_GE(without.json["summary"]["map_resets"].get<int>(), 1);
+}
+
+// Monocular: when the view clears onto what the map does not hold, the camera is lost. Re-anchoring
+// (Tracking.reanchor_max_s) makes a two-view map there and places it in the same map by the motion before
+// the loss, scaled by it: one map, and the frames after it keep the scale of the frames before.
+TEST(RunBlackout, MonocularReanchorsIntoTheSameMapWithTheScaleOfBefore) {
+  test::TempDir tmp;
+  const Blackout b = make_blackout(tmp);
+  const auto summary = run_on(b, tmp / "mono", "", io::SensorKind::kMonocular);
+  const auto& doc = summary.json;
+  EXPECT_EQ(doc["summary"]["map_resets"].get<int>(), 0);
+  EXPECT_EQ(doc["segments"].size(), 1u);
+  ASSERT_GE(doc["summary"]["reanchors"].get<int>(), 1);
+  double reanchor_s = -1;
+  int lost_before = 0;
+  for (const auto& f : doc["frames"]) {
+    if (f["method"] == "reanchor") {
+      reanchor_s = f["timestamp"].get<double>();
+      break;
+    }
+    if (f["state"] == "lost") ++lost_before;
+  }
+  ASSERT_GT(reanchor_s, 0);
+  EXPECT_GE(lost_before, 1);  // re-anchoring follows a loss; frames before it stay lost, not tracked
+  // Scale of the tracked poses before and after the re-anchoring, each aligned to the ground truth (Sim3).
+  const auto camera = io::read_tum_trajectory((tmp / "mono" / "CameraTrajectory.txt").string());
+  const auto truth = io::read_tum_trajectory((b.dir / "groundtruth.txt").string());
+  io::Trajectory before, after;
+  for (const auto& pose : camera) (pose.timestamp_s < reanchor_s ? before : after).push_back(pose);
+  ASSERT_GE(before.size(), 30u);
+  ASSERT_GE(after.size(), 30u);
+  eval::AteOptions sim3;
+  sim3.alignment = eval::Alignment::kSim3;
+  const double scale_before = eval::evaluate_ate(truth, before, sim3).alignment.scale;
+  const double scale_after = eval::evaluate_ate(truth, after, sim3).alignment.scale;
+  std::printf("[ measured ] monocular blackout: re-anchored at %.2f s, scale before %.3f after %.3f, ATE %.4f m\n",
+              reanchor_s, scale_before, scale_after, doc["summary"]["ate_rmse_m"].get<double>());
+  EXPECT_NEAR(scale_after / scale_before, 1.0, 0.25);
+
+  // Without re-anchoring the camera stays lost, and a second later a new map starts.
+  const auto without = run_on(b, tmp / "mono_without", "\nTracking.reanchor_max_s: 0\n", io::SensorKind::kMonocular);
+  EXPECT_GE(without.json["summary"]["map_resets"].get<int>(), 1);
+  EXPECT_EQ(without.json["summary"]["reanchors"].get<int>(), 0);
 }

@@ -225,3 +225,52 @@ TEST(MonocularInitOptions, CheckNamesTheBadValue) {
   options.two_view.min_parallax_deg = -1;
   EXPECT_THROW(tracking::MonocularInitializer{options}, InputError);
 }
+
+// Monocular re-anchoring (InitialMapPlacement): into a map that already holds a keyframe, the reference
+// frame goes where the placement says and the map is scaled to the predicted baseline (here the true
+// pose and baseline: the two-view map then lands on the true geometry); with a baseline too small to
+// measure, to the expected median depth.
+TEST_F(MonocularInit, APlacedMapLandsWhereTheMotionSaysAtItsScale) {
+  tracking::MonocularInitializer initializer;
+  const synth::RenderedFrame first = synth::render_frame(*scene_, 0);
+  initializer.add_frame(make_frame(0, first.colour));
+  map::Frame current = make_frame(6, synth::render_frame(*scene_, 6).colour);
+  const auto init = initializer.add_frame(current);
+  ASSERT_TRUE(init.has_value());
+  map::Map map;
+  const auto existing = std::make_shared<map::KeyFrame>(map.next_keyframe_id(), 99, 0.0, current.camera,
+                                                        current.levels, current.features, geometry::SE3());
+  map.add_keyframe(existing);
+
+  const geometry::SE3 reference_pose = world_from_cam(0).inverse();
+  const geometry::SE3 current_pose = world_from_cam(6).inverse();
+  tracking::InitialMapPlacement placement;
+  placement.reference_cam_from_world = reference_pose;
+  placement.predicted_baseline = (world_from_cam(6).translation() - world_from_cam(0).translation()).norm();
+  placement.expected_median_depth = 2.0;
+  const auto keyframes = tracking::build_initial_map(map, *init, current, initializer.options(), &placement);
+  ASSERT_TRUE(keyframes.has_value());
+  EXPECT_TRUE(placement.scaled_by_baseline);
+  EXPECT_EQ(map.num_keyframes(), 3u);
+  const auto& [kf1, kf2] = *keyframes;
+  EXPECT_LT((kf1->cam_from_world().translation() - reference_pose.translation()).norm(), 1e-9);
+  EXPECT_LT(rotation_error_deg(kf2->cam_from_world(), current_pose), 0.5);
+  const double centre_error = (kf2->world_from_cam().translation() - world_from_cam(6).translation()).norm();
+  EXPECT_LT(centre_error, 0.1 * placement.predicted_baseline);
+  // The points at the renderer's depths, in metres.
+  std::vector<double> relative;
+  for (const auto& p : kf1->valid_map_points()) {
+    const float depth = true_depth(first, kf1->features->keys[static_cast<size_t>(p->index_in(kf1->id))].pt);
+    if (depth > 0) relative.push_back(std::abs((kf1->cam_from_world() * p->world()).z() - depth) / depth);
+  }
+  ASSERT_GT(relative.size(), 50u);
+  EXPECT_LT(median(relative), 0.05);
+
+  // A baseline of 1 % of the expected depth is not measured: the median depth sets the scale.
+  map::Map other;
+  map::Frame again = make_frame(6, synth::render_frame(*scene_, 6).colour);
+  placement.predicted_baseline = 0.01 * placement.expected_median_depth;
+  ASSERT_TRUE(tracking::build_initial_map(other, *init, again, initializer.options(), &placement).has_value());
+  EXPECT_FALSE(placement.scaled_by_baseline);
+  EXPECT_NEAR(other.keyframes().front()->scene_median_depth(), 2.0, 1e-3);
+}

@@ -128,6 +128,9 @@ struct TrackingSettings {
   // and no new map is started meanwhile (0 = off).
   double bridge_max_s = 3.0;
   double bridge_min_people_share = 0.5;
+  // Monocular: lost in a grown map, a two-view map made where the camera is joins the same map, placed
+  // and scaled by the motion before the loss, if it succeeds within reanchor_max_s (0 = off: a new map).
+  double reanchor_max_s = 3.0;
 };
 
 // A monocular camera that rides at a constant height above planar ground (on a car or a ground robot):

@@ -228,6 +228,9 @@ void check_own_sections(const Checker& c, const Settings& s) {
             s.tracking.odometry_bridge_min_inliers);
   c.require(std::isfinite(s.tracking.bridge_max_s) && s.tracking.bridge_max_s >= 0 && s.tracking.bridge_max_s <= 60,
             "Tracking.bridge_max_s", "in [0, 60] seconds (0 = off)", s.tracking.bridge_max_s);
+  c.require(std::isfinite(s.tracking.reanchor_max_s) && s.tracking.reanchor_max_s >= 0 &&
+                s.tracking.reanchor_max_s <= 60,
+            "Tracking.reanchor_max_s", "in [0, 60] seconds (0 = off)", s.tracking.reanchor_max_s);
   c.require(std::isfinite(s.tracking.bridge_min_people_share) && s.tracking.bridge_min_people_share >= 0 &&
                 s.tracking.bridge_min_people_share <= 1,
             "Tracking.bridge_min_people_share", "in [0, 1]", s.tracking.bridge_min_people_share);

@@ -82,6 +82,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Tracking.odometry_bridge_min_inliers",
                                   "Tracking.bridge_max_s",
                                   "Tracking.bridge_min_people_share",
+                                  "Tracking.reanchor_max_s",
                                   "Ground.enabled",
                                   "Ground.keyframe_sigma",
                                   "FeatureBudget.enabled",

@@ -339,6 +339,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
       {"keyframes", slam.num_keyframes()},
       {"map_points", slam.num_map_points()},
       {"map_resets", slam.map_resets()},
+      {"reanchors", slam.reanchors()},
       {"waited_for_mapping_ms", waited_for_mapping_ms},
       {"frames_waited_for_mapping", frames_waited},
       {"ate_rmse_m", optional_json(summary.ate_rmse_m)},

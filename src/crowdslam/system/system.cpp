@@ -95,6 +95,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   }
   tracker_options.odometry_bridge_min_inliers = settings.tracking.odometry_bridge_min_inliers;
   tracker_options.bridge_max_s = settings.tracking.bridge_max_s;
+  tracker_options.reanchor_max_s = settings.tracking.reanchor_max_s;
   tracker_options.bridge_min_people_share = settings.tracking.bridge_min_people_share;
   const io::GeometrySettings& g = settings.geometry;
   tracker_options.dynamic.enabled = g.dynamic_check;
@@ -342,6 +343,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
 
   report.state = result.state;
   report.method = result.method;
+  if (report.method == "reanchor") ++reanchors_;
   report.new_keyframe = result.new_keyframe;
   report.rescued_with_boxes = result.rescued_with_boxes;
   report.box_matches = result.box_matches;

@@ -178,6 +178,8 @@ class System {
   [[nodiscard]] const std::optional<FinalGroundBa>& final_ground_ba() const { return final_ground_ba_; }
   [[nodiscard]] bool loop_closing_enabled() const { return loop_closer_ != nullptr; }
   [[nodiscard]] int map_resets() const { return map_resets_; }
+  // Monocular re-anchorings: a two-view map placed in the same map after a loss (method "reanchor").
+  [[nodiscard]] int reanchors() const { return reanchors_; }
   [[nodiscard]] bool people_filter_enabled() const { return people_ != nullptr; }
   [[nodiscard]] std::string detector_name() const;
   // The people filter's stage (null when the filter is off).
@@ -228,6 +230,7 @@ class System {
   int next_feature_budget_ = 0;
   uint64_t next_frame_id_ = 0;
   int map_resets_ = 0;
+  int reanchors_ = 0;
   std::optional<mapdb::MapOrigin> loaded_map_origin_;
   std::optional<std::chrono::steady_clock::time_point> last_snapshot_;
   std::optional<geometry::GroundPlaneOptions> ground_;

@@ -145,7 +145,7 @@ std::optional<TwoViewInitialization> MonocularInitializer::add_frame(const map::
 
 std::optional<std::pair<std::shared_ptr<map::KeyFrame>, std::shared_ptr<map::KeyFrame>>> build_initial_map(
     map::Map& map, const TwoViewInitialization& init, map::Frame& current,
-    const MonocularInitializerOptions& options) {
+    const MonocularInitializerOptions& options, InitialMapPlacement* placement) {
   const map::Frame& ref = *init.reference;
   auto kf1 = std::make_shared<map::KeyFrame>(map.next_keyframe_id(), ref.id, ref.timestamp_s, ref.camera,
                                              ref.levels, ref.features, geometry::SE3::identity());
@@ -207,25 +207,44 @@ std::optional<std::pair<std::shared_ptr<map::KeyFrame>, std::shared_ptr<map::Key
     points[link.point]->erase_observation(link.keyframe->id);  // two-view point: now bad
   }
 
-  // Scale: median depth of the first keyframe's points = 1.
+  // Scale: median depth of the first keyframe's points = 1 (or as the placement says).
   const float median_depth = kf1->scene_median_depth();
   const int tracked = kf2->tracked_map_points(1);
   if (!(median_depth > 0) || tracked < options.min_map_points) {
     spdlog::info(
         "monocular init at frame {} rejected: median depth {:.3f}, {} points after bundle adjustment",
         current.id, median_depth, tracked);
-    map.clear();
+    if (placement == nullptr) {
+      map.clear();
+    } else {
+      for (const auto& point : points) map.erase_map_point(point->id);
+      map.erase_keyframe(kf2->id);
+      map.erase_keyframe(kf1->id);
+    }
     return std::nullopt;
   }
-  const double scale = 1.0 / median_depth;
+  double scale = 1.0 / median_depth;
+  geometry::SE3 world_from_reference;  // identity: the reference is the world's origin
+  if (placement != nullptr) {
+    const double baseline = kf2->cam_from_world().translation().norm();
+    placement->scaled_by_baseline =
+        baseline > 0 && placement->predicted_baseline >=
+                            placement->min_baseline_share * placement->expected_median_depth;
+    scale = placement->scaled_by_baseline ? placement->predicted_baseline / baseline
+                                          : placement->expected_median_depth / median_depth;
+    placement->scale = scale;
+    world_from_reference = placement->reference_cam_from_world.inverse();
+  }
   const geometry::SE3 pose2 = kf2->cam_from_world();
-  kf2->set_cam_from_world(geometry::SE3(pose2.rotation(), pose2.translation() * scale));
+  const geometry::SE3 reference_from_world = world_from_reference.inverse();
+  kf1->set_cam_from_world(reference_from_world);
+  kf2->set_cam_from_world(geometry::SE3(pose2.rotation(), pose2.translation() * scale) * reference_from_world);
   std::fill(current.map_points.begin(), current.map_points.end(), nullptr);
   std::fill(current.outliers.begin(), current.outliers.end(), false);
   for (size_t k = 0; k < points.size(); ++k) {
     auto& point = points[k];
     if (point->is_bad()) continue;
-    point->set_world(point->world() * scale);
+    point->set_world(world_from_reference * (point->world() * scale));
     point->update_normal_and_depth();
     current.map_points[init.matches[k].current_index] = point;
   }

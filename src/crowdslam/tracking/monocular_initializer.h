@@ -77,11 +77,26 @@ class MonocularInitializer {
   int last_num_matches_ = 0;
 };
 
+// Where a two-view map goes in a map that already holds keyframes (monocular re-anchoring, tracker's
+// TrackerOptions::monocular_reanchor): the reference frame's pose and the scale, from the motion tracked
+// before the loss. The scale makes the baseline `predicted_baseline` when that is at least
+// `min_baseline_share` of `expected_median_depth` (the camera moved enough to measure it), otherwise
+// makes the reference's median scene depth `expected_median_depth`.
+struct InitialMapPlacement {
+  geometry::SE3 reference_cam_from_world;
+  double predicted_baseline = 0;
+  double expected_median_depth = 1;
+  double min_baseline_share = 0.02;
+  bool scaled_by_baseline = false;  // output: which of the two fixed the scale
+  double scale = 1;                 // output: the scale applied to the two-view reconstruction
+};
+
 // The initial map in `map` from a reconstruction whose current frame is `current`: two keyframes, their
-// points, bundle adjustment, scaling to median depth 1. On success fills current.cam_from_world and its
-// map point slots and returns the two keyframes (reference first); on failure leaves `map` empty.
+// points, bundle adjustment, scaling to median depth 1 (or, with `placement`, placed and scaled as it
+// says). On success fills current.cam_from_world and its map point slots and returns the two keyframes
+// (reference first); on failure removes what it added (without a placement: leaves `map` empty).
 std::optional<std::pair<std::shared_ptr<map::KeyFrame>, std::shared_ptr<map::KeyFrame>>> build_initial_map(
     map::Map& map, const TwoViewInitialization& init, map::Frame& current,
-    const MonocularInitializerOptions& options);
+    const MonocularInitializerOptions& options, InitialMapPlacement* placement = nullptr);
 
 }  // namespace crowdslam::tracking

@@ -43,6 +43,7 @@ void TrackerOptions::check() const {
   if (keyframe_reference_min_found < 0)
     throw InputError("tracker: keyframe_reference_min_found must be >= 0");
   if (!(bridge_max_s >= 0)) throw InputError("tracker: bridge_max_s must be >= 0");
+  if (!(reanchor_max_s >= 0)) throw InputError("tracker: reanchor_max_s must be >= 0");
   if (!(bridge_min_people_share >= 0 && bridge_min_people_share <= 1))
     throw InputError("tracker: bridge_min_people_share must be in [0, 1]");
   pose.check();
@@ -55,6 +56,7 @@ Tracker::Tracker(const TrackerOptions& options, std::shared_ptr<map::Map> map, K
       map_(std::move(map)),
       mapper_(mapper),
       monocular_initializer_(options.monocular_init),
+      reanchor_initializer_(reanchor_initializer_options(options.monocular_init)),
       dynamic_check_(options.dynamic) {
   options_.check();
 }
@@ -64,6 +66,7 @@ void Tracker::reset() {
   last_tracked_s_.reset();
   last_bridged_s_.reset();
   bridge_motion_.reset();
+  reanchor_.reset();
   recent_poses_.clear();
   next_frame_wait_ = NextFrameWait::kNone;
   state_ = TrackingState::kNotInitialized;
@@ -265,6 +268,10 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       last_tracked_s_ = frame.timestamp_s;
       last_bridged_s_.reset();
       bridge_motion_.reset();
+      if (reanchor_) {  // relocalised while re-anchoring was possible
+        reanchor_.reset();
+        reanchor_initializer_.reset();
+      }
       if (resumes) {
         velocity_ = geometry::SE3::exp(motion->twist_per_s * (frame.timestamp_s - last_frame_->timestamp_s));
       } else if (last_frame_ && last_frame_->cam_from_world && !after_bridge) {
@@ -323,6 +330,9 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       lost_frames_ = 0;
       result.bridged_cam_from_world = frame.cam_from_world;
     } else {
+      if (options_.monocular && lost_frames_ == 0) {
+        start_reanchor(after_bridge ? bridge_motion_ : recent_motion(frame, velocity_at_start));
+      }
       velocity_.reset();
       bridge_motion_.reset();
       recent_poses_.clear();
@@ -330,10 +340,16 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       if (!last_tracked_s_) last_tracked_s_ = frame.timestamp_s;  // lost from its first frame (a new map)
       // The clock runs from the last frame with a pose; after a bridge, from when the view cleared.
       const double lost_s = std::abs(frame.timestamp_s - last_bridged_s_.value_or(*last_tracked_s_));
-      if (!map_loaded_ &&
+      if (reanchor_ && reanchor(frame)) {
+        state_ = TrackingState::kOk;
+        result.method = "reanchor";
+        result.new_keyframe = true;
+      } else if (!map_loaded_ &&
           map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) {
         spdlog::warn("tracking lost with only {} keyframes: resetting the map", map_->num_keyframes());
         result.map_reset = true;
+      } else if (reanchor_) {
+        // Re-anchoring may still place the camera in this map: no new map meanwhile.
       } else if (!map_loaded_ && options_.new_map_after_lost_s > 0 &&
                  lost_s >= options_.new_map_after_lost_s &&
                  lost_frames_ >= options_.new_map_after_lost_min_frames) {

@@ -82,6 +82,15 @@ struct TrackerOptions {
   // cameras did; at least `new_map_after_lost_min_frames` relocalisation attempts are made first.
   double new_map_after_lost_s = 1.0;
   int new_map_after_lost_min_frames = 3;
+  // Monocular re-anchoring (docs/CROWDS.md#monocular-re-anchoring): lost in a map of more than
+  // reset_if_lost_within_keyframes keyframes, each frame is also offered to a two-view initialisation
+  // (relocalisation is tried first, as always). When one succeeds within `reanchor_max_s` of the last
+  // pose, its two keyframes join the same map (method "reanchor"): placed where the motion tracked before
+  // the loss puts the initializer's reference frame, and scaled so that the two views' baseline is the
+  // one that motion predicts (by the last reference keyframe's median scene depth when the camera barely
+  // moved). No new map is started meanwhile; after `reanchor_max_s` the new-map rule above applies.
+  // 0 = off.
+  double reanchor_max_s = 3.0;
   // RGB-D / stereo: a frame the motion model places with at least this many inliers among the last
   // frame's points, its depth points (visual odometry) included, is tracked even when it sees too few
   // map points for the local map, and becomes a keyframe at once, so the map gets points where the camera
@@ -126,6 +135,9 @@ struct TrackerOptions {
   void check() const;
 };
 
+// The two-view initialisation's options for monocular re-anchoring (tracker_reanchor.cpp).
+MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOptions options);
+
 // Per-frame outcome, for statistics and trajectory output.
 struct TrackResult {
   TrackingState state = TrackingState::kNotInitialized;
@@ -135,7 +147,8 @@ struct TrackResult {
   bool map_reset = false;
   int tracked_points = 0;  // inliers after local-map tracking
   int keypoints = 0;
-  // "init", "motion", "reference", "relocalization", "motion+boxes", "odometry", "bridged", "lost"
+  // "init", "motion", "reference", "relocalization", "motion+boxes", "odometry", "bridged", "reanchor",
+  // "lost"
   const char* method = "";
   // State kBridged: the motion model's pose for the frame (not a tracked pose).
   std::optional<geometry::SE3> bridged_cam_from_world;
@@ -254,12 +267,21 @@ class Tracker {
   // Whether `frame` can be bridged (TrackerOptions::bridge_max_s): within bridge_max_s of the last tracked
   // frame, with a motion to follow. Sets the frame's pose from it (no matches) if so.
   bool bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const;
+  // The motion bridge_motion() would follow, also when the bridge is off (monocular re-anchoring).
+  [[nodiscard]] std::optional<BridgeMotion> recent_motion(const map::Frame& frame,
+                                                          const std::optional<geometry::SE3>& velocity) const;
+  // Monocular re-anchoring (TrackerOptions::reanchor_max_s, tracker_reanchor.cpp): remembers the motion
+  // and scene depth at the loss; then offers each lost frame to the two-view initialisation and, when it
+  // succeeds, adds its two keyframes to the map where that motion puts them. True when `frame` is tracked.
+  void start_reanchor(const std::optional<BridgeMotion>& motion);
+  bool reanchor(map::Frame& frame);
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
   KeyframeConsumer* mapper_;
   Relocalizer relocalizer_;
   MonocularInitializer monocular_initializer_;
+  MonocularInitializer reanchor_initializer_;  // its options: reanchor_initializer_options()
   DynamicCheck dynamic_check_;
   const loop::KeyframeDatabase* database_ = nullptr;
   std::shared_ptr<const bow::Vocabulary> vocabulary_;
@@ -283,6 +305,11 @@ class Tracker {
   int lost_frames_ = 0;                   // consecutive lost frames (new_map_after_lost_min_frames)
   std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
   std::optional<BridgeMotion> bridge_motion_;  // while bridging
+  struct Reanchor {
+    BridgeMotion motion;          // from the last pose before the loss
+    double median_depth = 1;      // of the reference keyframe then
+  };
+  std::optional<Reanchor> reanchor_;  // while lost in a monocular map that may be re-anchored
   struct RecentPose {
     double timestamp_s = 0;
     geometry::SE3 cam_from_world;

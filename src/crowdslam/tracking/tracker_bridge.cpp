@@ -9,6 +9,11 @@ namespace crowdslam::tracking {
 std::optional<Tracker::BridgeMotion> Tracker::bridge_motion(const map::Frame& frame,
                                                              const std::optional<geometry::SE3>& velocity) const {
   if (options_.bridge_max_s <= 0) return std::nullopt;
+  return recent_motion(frame, velocity);
+}
+
+std::optional<Tracker::BridgeMotion> Tracker::recent_motion(const map::Frame& frame,
+                                                             const std::optional<geometry::SE3>& velocity) const {
   // The last reliable frame, and the earliest reliable one within half a second before it.
   const RecentPose* anchor = nullptr;
   const RecentPose* base = nullptr;

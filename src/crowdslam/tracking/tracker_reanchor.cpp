@@ -1,0 +1,86 @@
+// Monocular re-anchoring (TrackerOptions::reanchor_max_s, docs/CROWDS.md#monocular-re-anchoring): a
+// monocular camera lost where its map holds nothing it can see (people hid the map while the camera
+// turned to new walls) starts a two-view reconstruction there, as at the start, and places it in the same
+// map by the motion tracked before the loss instead of starting a new map.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "crowdslam/map/map_point.h"
+#include "crowdslam/tracking/frame_bow.h"
+#include "crowdslam/tracking/tracker.h"
+
+namespace crowdslam::tracking {
+
+MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOptions options) {
+  // What people leave of a view is a few hundred keypoints: all pyramid levels up to 2 take part, and
+  // fewer matches and points do (the placement, not the two views alone, fixes the pose).
+  options.max_level = std::max(options.max_level, 2);
+  options.min_matches = std::min(options.min_matches, 70);
+  options.min_map_points = std::min(options.min_map_points, 70);
+  return options;
+}
+
+void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion) {
+  reanchor_.reset();
+  reanchor_initializer_.reset();
+  if (options_.reanchor_max_s <= 0 || !motion || map_loaded_ || localization_only_) return;
+  if (map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) return;
+  const auto reference = reference_keyframe_ && !reference_keyframe_->is_bad() ? reference_keyframe_ : last_keyframe_;
+  const float depth = reference ? reference->scene_median_depth() : 0.0F;
+  if (!(depth > 0)) return;
+  reanchor_ = Reanchor{*motion, depth};
+}
+
+bool Tracker::reanchor(map::Frame& frame) {
+  if (frame.timestamp_s - reanchor_->motion.anchor_s > options_.reanchor_max_s) {
+    spdlog::info("monocular re-anchoring given up {:.1f} s after the last pose", options_.reanchor_max_s);
+    reanchor_.reset();
+    reanchor_initializer_.reset();
+    return false;
+  }
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);  // either frame may become a keyframe
+  const auto init = reanchor_initializer_.add_frame(frame);
+  if (!init) return false;
+  const BridgeMotion& motion = reanchor_->motion;
+  InitialMapPlacement placement;
+  placement.reference_cam_from_world = motion.at(init->reference->timestamp_s);
+  const geometry::SE3 current_pose = motion.at(frame.timestamp_s);
+  placement.predicted_baseline =
+      (current_pose.inverse().translation() - placement.reference_cam_from_world.inverse().translation()).norm();
+  placement.expected_median_depth = reanchor_->median_depth;
+  const auto keyframes = build_initial_map(*map_, *init, frame, options_.monocular_init, &placement);
+  if (!keyframes) {
+    reanchor_initializer_.reset();
+    reanchor_initializer_.add_frame(frame);
+    frame.cam_from_world.reset();
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    return false;
+  }
+  const auto& [first, second] = *keyframes;
+  spdlog::info(
+      "monocular re-anchoring: frames {} and {} placed in the map {:.2f} s after the last pose, scale {:.3f} "
+      "from the {} ({} points)",
+      init->reference->id, frame.id, frame.timestamp_s - motion.anchor_s, placement.scale,
+      placement.scaled_by_baseline ? "predicted baseline" : "scene depth", second->tracked_map_points(1));
+  mapper_->insert_keyframe(first);
+  mapper_->insert_keyframe(second);
+  last_keyframe_ = second;
+  last_keyframe_frame_id_ = frame.id;
+  last_keyframe_indices_.clear();
+  reference_keyframe_ = second;
+  frame.reference_keyframe = second;
+  local_keyframes_ = {first, second};
+  local_points_ = second->valid_map_points();
+  inliers_in_local_map_ = static_cast<int>(local_points_.size());
+  velocity_.reset();  // the next frame is tracked against the reference keyframe
+  frame.discard_outliers();
+  reanchor_initializer_.reset();
+  reanchor_.reset();
+  lost_frames_ = 0;
+  last_tracked_s_ = frame.timestamp_s;
+  last_bridged_s_.reset();
+  return true;
+}
+
+}  // namespace crowdslam::tracking
