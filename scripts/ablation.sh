@@ -18,16 +18,17 @@ dataset="${1:-${CROWDSLAM_SHARED:-../shared}/data/bonn_crowd}"
 dir=out/ablation
 mkdir -p "$dir"
 base=config/Bonn.yaml
-variant() {  # name, sed expression on the base settings
+variant() {  # name, sed expression on the base settings[, a settings line to append]
   sed -e "$2" "$base" > "$dir/$1.yaml"
+  if [[ -n "${3:-}" ]]; then printf '%s\n' "$3" >> "$dir/$1.yaml"; fi
 }
 variant paper       's/^PeopleFilter.mode: .*/PeopleFilter.mode: "paper"/'
 variant paper_nofnu 's/^PeopleFilter.mode: .*/PeopleFilter.mode: "paper"/; s/^FeatureBudget.enabled: .*/FeatureBudget.enabled: 0/'
-variant paper_nms   's/^PeopleFilter.mode: .*/PeopleFilter.mode: "paper"/; s/^Detector.filter_before_nms: .*/Detector.filter_before_nms: 0/'
+variant paper_nms   's/^PeopleFilter.mode: .*/PeopleFilter.mode: "paper"/' 'Detector.filter_before_nms: 0'
 variant depth       's/^PeopleFilter.mode: .*/PeopleFilter.mode: "depth"/'
 variant depth_nofnu 's/^PeopleFilter.mode: .*/PeopleFilter.mode: "depth"/; s/^FeatureBudget.enabled: .*/FeatureBudget.enabled: 0/'
 variant depth_union 's/^PeopleFilter.mode: .*/PeopleFilter.mode: "depth"/; s/^FeatureBudget.area: .*/FeatureBudget.area: "union"/'
-variant depth_nms   's/^PeopleFilter.mode: .*/PeopleFilter.mode: "depth"/; s/^Detector.filter_before_nms: .*/Detector.filter_before_nms: 0/'
+variant depth_nms   's/^PeopleFilter.mode: .*/PeopleFilter.mode: "depth"/' 'Detector.filter_before_nms: 0'
 
 echo "| variant | tracked % | ATE RMSE (m) | frames/s |"
 echo "| --- | --- | --- | --- |"

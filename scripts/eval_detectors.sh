@@ -28,7 +28,7 @@ for model in body coco yolox bytetrack; do
     configs+=("$model $input 0.2 0.1" "$model $input 0.3 0.45")
   done
 done
-# Boxes before NMS, as the SLAM filter uses them by default (Detector.filter_before_nms: 1).
+# Boxes before NMS, as the SLAM filter uses them by default with depth or stereo (Detector.filter_before_nms).
 configs+=("body 160 0.2 0.1 raw" "yolox 416x320 0.3 0.45 raw" "bytetrack 416x320 0.3 0.45 raw")
 if [[ -n "${EVAL_CONFIGS:-}" ]]; then IFS=';' read -r -a configs <<<"$EVAL_CONFIGS"; fi
 

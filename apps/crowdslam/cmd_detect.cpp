@@ -80,7 +80,7 @@ people::ModelFiles configure(DetectArgs& args) {
     o.input_height = setup.options.input_height;
     if (!given(app, "--confidence")) o.confidence = setup.options.confidence;
     if (!given(app, "--nms")) o.nms = setup.options.nms;
-    if (!given(app, "--raw")) args.raw = d.filter_before_nms;
+    if (!given(app, "--raw")) args.raw = d.filter_before_nms.value_or(true);
   } else if (model.detect_input.width > 0) {
     o.input_width = model.detect_input.width;
     o.input_height = model.detect_input.height;

@@ -48,7 +48,7 @@ class DetectorSettings:
     confidence: float
     nms: float
     person_class: int
-    filter_before_nms: bool
+    filter_before_nms: Optional[bool]  # None: raw boxes with depth or stereo, NMS boxes monocular
 
 class PeopleFilterSettings:
     enabled: bool

@@ -76,7 +76,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("Detector.confidence"), s.detector.confidence);
   set_if(r.real("Detector.nms"), s.detector.nms);
   set_if(r.integer("Detector.person_class"), s.detector.person_class);
-  set_if(r.flag("Detector.filter_before_nms"), s.detector.filter_before_nms);
+  if (const auto raw = r.flag("Detector.filter_before_nms")) s.detector.filter_before_nms = *raw;
   set_if(r.real("Detector.raw_box_max_area_ratio"), s.detector.raw_box_max_area_ratio);
   set_if(r.text("Detector.mode"), s.detector.mode);
   set_if(r.integer("Detector.latest_interval"), s.detector.latest_interval);

@@ -57,7 +57,10 @@ struct DetectorSettings {
   double confidence = 0.2;
   double nms = 0.1;
   int person_class = 0;
-  bool filter_before_nms = true;
+  // Mask with the raw (pre-NMS) boxes (Crowd-SLAM). Unset: with depth or stereo yes (the depth check
+  // gives back the background they cover), monocular no (nothing gives it back; in crowds the raw boxes'
+  // union covers the background between people). docs/CROWDS.md#the-people-filter-and-the-feature-budget
+  std::optional<bool> filter_before_nms;
   // Raw boxes over this many times the area of their NMS box are not used as masks (0 = all raw boxes,
   // as the paper); see people::raw_boxes_near_leaders.
   double raw_box_max_area_ratio = 2.0;

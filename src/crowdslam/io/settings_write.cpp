@@ -94,7 +94,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
   if (d.resize != "auto") out << "\nDetector.resize: " << quoted(d.resize);
   out << "\nDetector.confidence: " << real_text(d.confidence) << "\nDetector.nms: " << real_text(d.nms)
       << "\nDetector.person_class: " << d.person_class
-      << "\nDetector.filter_before_nms: " << (d.filter_before_nms ? 1 : 0)
+      << (d.filter_before_nms ? std::string("\nDetector.filter_before_nms: ") + (*d.filter_before_nms ? "1" : "0")
+                              : std::string())
       << "\nDetector.raw_box_max_area_ratio: " << real_text(d.raw_box_max_area_ratio)
       << "\nDetector.mode: " << quoted(d.mode) << "\nDetector.latest_interval: " << d.latest_interval
       << "\nDetector.tracker: " << (d.tracker ? 1 : 0) << "\nDetector.track_iou: " << real_text(d.track_iou)

@@ -90,6 +90,7 @@ class PeopleStage {
   [[nodiscard]] DetectorMode mode() const { return mode_; }
   [[nodiscard]] bool tracker_enabled() const { return tracker_.has_value(); }
   [[nodiscard]] const PeopleStageStats& stats() const { return stats_; }
+  [[nodiscard]] bool filter_before_nms() const { return filter_before_nms_; }  // raw boxes mask
 
  private:
   // A detection result in the current frame's coordinates: moved from its own frame's grey image.
@@ -112,7 +113,7 @@ class PeopleStage {
   AreaMode area_mode_ = AreaMode::kSum;
   BoxFlowOptions flow_options_;
   std::optional<BoxTracker> tracker_;
-  bool filter_before_nms_ = true;
+  bool filter_before_nms_ = true;  // Settings' filter_before_nms, or its default for the sensor
   double raw_box_max_area_ratio_ = 0.0;
   bool right_image_boxes_ = false;
   double flat_box_margin_m_ = 0;
