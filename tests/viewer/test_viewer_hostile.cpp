@@ -118,6 +118,31 @@ TEST(ViewerHostile, ClientReportIsParsedAndStateStaysOneValidDocument) {
   EXPECT_EQ(state["client"]["note"], "a \"quoted\" word");
 }
 
+// The end of a run reaches every open event stream: stop() lets them write what is left ("finish" after
+// the last frames) before the connections close; one that does not read is cut off after the drain time.
+TEST(ViewerHostile, StoppingDeliversTheLastEventsToOpenStreams) {
+  LiveServer live;
+  const int port = live.server->port();
+  std::vector<std::unique_ptr<Socket>> streams;
+  for (int i = 0; i < 3; ++i) {
+    streams.push_back(std::make_unique<Socket>(port));
+    streams.back()->send(std::string("GET /events?image=0") + (i == 2 ? "&batch_ms=500" : "") +
+                         " HTTP/1.1\r\nHost: x\r\n\r\n");
+    ASSERT_NE(streams.back()->receive(2000ms, "event: session").find("event: session"), std::string::npos);
+  }
+  Socket idle(port);  // never reads: its stream fills its socket buffer, then the drain time ends it
+  idle.send("GET /events HTTP/1.1\r\nHost: x\r\n\r\n");
+  for (int i = 0; i < 50; ++i) live.stream.publish("frame", "{\"index\":" + std::to_string(i) + "}");
+  live.stream.publish("finish", "{\"end_state\":\"completed\"}");
+  const auto start = Clock::now();
+  live.server->stop();
+  EXPECT_LT(Clock::now() - start, 3000ms);
+  for (auto& s : streams) {
+    const auto got = s->receive(2000ms);  // until the server closes the connection
+    EXPECT_NE(got.find("event: finish"), std::string::npos) << got.substr(0, 300);
+  }
+}
+
 // Finding 5: 8 open event streams took all 8 worker threads; slowloris sockets starved /state.
 TEST(ViewerHostile, OpenStreamsAndSlowlorisNeverBlockTheControlsOrThePage) {
   viewer::HttpServerOptions http;

@@ -172,6 +172,12 @@ void ViewerServer::start() {
 
 void ViewerServer::stop() {
   stream_.close();
+  // The event streams write what is left (the final map, "finish") and close by themselves; a client
+  // that does not read is cut off after the drain time.
+  const auto deadline = std::chrono::steady_clock::now() + options_.drain;
+  while (server_ && stream_.clients() > 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   if (server_) server_->stop();
 }
 

@@ -5,6 +5,7 @@
 // paths and nothing from the file system, binds to 127.0.0.1 unless told otherwise, and has no
 // authentication (docs/VIEWER.md). Open event streams and slow clients never block the page, /state or
 // the controls.
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -22,6 +23,9 @@ struct ViewerServerOptions {
   int port = 8080;         // 0: any free port
   std::string three_dir;   // "" = $CROWDSLAM_THREE_DIR or the Debian path (/usr/share/javascript/three)
   HttpServerOptions http;  // connection and stream caps, request and write timeouts
+  // stop(): how long open event streams get to write what is left (the end of the run) before the
+  // connections are closed.
+  std::chrono::milliseconds drain{2000};
   void check() const;      // throws InputError naming the bad option
 };
 
