@@ -67,8 +67,17 @@ int release_static_boxes(map::Frame& frame, const std::vector<int>& box_of, cons
 }  // namespace
 
 std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, bool tracked,
-                                                      const BoxKeypoints& boxes, int& static_boxes) {
-  if (!tracked && !(velocity_ && last_frame_ && last_frame_->cam_from_world)) return std::nullopt;
+                                                      const BoxKeypoints& boxes, int& static_boxes,
+                                                      const std::optional<geometry::SE3>& guess) {
+  std::optional<geometry::SE3> pose;
+  if (tracked) {
+    pose = frame.cam_from_world;
+  } else if (velocity_ && last_frame_ && last_frame_->cam_from_world) {
+    pose = *velocity_ * *last_frame_->cam_from_world;
+  } else {
+    pose = guess;
+  }
+  if (!pose) return std::nullopt;
   if (!tracked && !options_.box_rescue) return std::nullopt;
 
   if (local_points_.empty()) return std::nullopt;
@@ -93,7 +102,7 @@ std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, b
       had_match[i] = true;
     }
   }
-  full.cam_from_world = tracked ? *frame.cam_from_world : *velocity_ * *last_frame_->cam_from_world;
+  full.cam_from_world = *pose;
   const int before = tracked ? count_tracked_in_map(full) : 0;
 
   // The trusted points of the local map that are not matched yet, projected with the pose.

@@ -203,9 +203,13 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       }
       dynamic_check_.set_suspended(false);
     }
+    // While bridged, the keypoints in boxes are searched from where the bridge puts the frame: a person
+    // close to a monocular camera hides the map outside the boxes, not behind them.
+    std::optional<geometry::SE3> bridged_guess;
+    if (!ok && after_bridge && motion) bridged_guess = motion->at(frame.timestamp_s);
     if (boxes && options_.box_keypoints &&
-        (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking)) {
-      if (auto full = with_box_keypoints(frame, ok, boxes, result.static_boxes)) {
+        (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking || bridged_guess)) {
+      if (auto full = with_box_keypoints(frame, ok, boxes, result.static_boxes, bridged_guess)) {
         if (!ok) {
           result.method = "motion+boxes";
           result.rescued_with_boxes = true;

@@ -242,9 +242,11 @@ class Tracker {
                                                        const std::shared_ptr<map::KeyFrame>& keyframe,
                                                        size_t keyframe_index) const;
   int count_tracked_in_map(const map::Frame& frame) const;
-  // The frame with its keypoints in boxes back (see track); nullopt when they do not help.
+  // The frame with its keypoints in boxes back (see track); nullopt when they do not help. A frame that
+  // failed is searched from the motion model's pose, or without a velocity (after a bridge) from `guess`.
   std::optional<map::Frame> with_box_keypoints(const map::Frame& frame, bool tracked,
-                                               const BoxKeypoints& boxes, int& static_boxes);
+                                               const BoxKeypoints& boxes, int& static_boxes,
+                                               const std::optional<geometry::SE3>& guess = std::nullopt);
   // The last frame with its box keypoints (depth only), and the evidence its box keypoints give about this
   // frame's: matched where the pose says (+1) or not (-1). See box_keypoints.cpp.
   void remember_box_frame(const map::Frame& full);
