@@ -39,7 +39,15 @@ def _args(value):
         return shlex.split(value)
     if isinstance(value, list):
         return [str(v) for v in value]
+    if isinstance(value, dict) and set(value) == {"args"}:  # a grid entry
+        return _args(value["args"])
     raise MatrixError(f"arguments must be a string or a list, not {value!r}")
+
+
+class _Keep(dict):
+    """Template values; other {placeholders} (such as {dataset}) are left for later."""
+    def __missing__(self, key):
+        return "{" + key + "}"
 
 
 def _grid(entries, kind):
@@ -51,11 +59,11 @@ def _grid(entries, kind):
             grid = entry.pop("grid")
             axes = list(grid)
             for values in itertools.product(*(grid[a] for a in axes)):
-                sub = dict(zip(axes, values))
-                fill = lambda v: v.format(**sub) if isinstance(v, str) else (
+                sub = _Keep(zip(axes, values))
+                fill = lambda v: v.format_map(sub) if isinstance(v, str) else (
                     [fill(x) for x in v] if isinstance(v, list) else (
                         {k: fill(x) for k, x in v.items()} if isinstance(v, dict) else v))
-                out[_check_name(kind, name.format(**sub))] = fill(entry)
+                out[_check_name(kind, name.format_map(sub))] = fill(entry)
         else:
             out[_check_name(kind, name)] = entry
     return out
@@ -127,6 +135,8 @@ class Matrix:
         return {"kind": "derived", "base": None if base == "dataset" else self.path(base), "set": lines}
 
     def _cases(self, blocks):
+        if not self.datasets:
+            return {}
         blocks = blocks if blocks is not None else [{}]
         cases = {}
         axes = (("datasets", self.datasets), ("settings", self.settings), ("options", self.options))
@@ -213,7 +223,11 @@ class Matrix:
         b = self.datasets[c["dataset"]]["baseline"]
         if not b:
             return None
-        other = f"{b['dataset']}.{c['settings']}.{b.get('options', c['options'])}"
+        options = b.get("options", c["options"])
+        options = options.get(c["options"]) if isinstance(options, dict) else options
+        if options is None:
+            return None
+        other = f"{b['dataset']}.{c['settings']}.{options}"
         return other if other in self.cases else None
 
 
