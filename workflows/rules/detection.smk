@@ -14,7 +14,7 @@ def detect_command(wc):
 
 
 rule detect:
-    input: bin=M.crowdslam, seq=f"{R}/_sequences/{{seq}}.manifest"
+    input: BIN, seq=f"{R}/_sequences/{{seq}}.manifest" if M.inputs == "files" else []
     output: directory(f"{R}/detect/{{config}}/{{seq}}")
     params: command=detect_command
     log: f"{R}/_logs/detect/{{config}}/{{seq}}.log"
@@ -24,12 +24,12 @@ rule detect:
 
 
 rule detect_eval:
-    input: det=f"{R}/detect/{{config}}/{{seq}}", bin=M.crowdslam
+    input: BIN, det=f"{R}/detect/{{config}}/{{seq}}"
     output: f"{R}/detect/{{config}}/{{seq}}.eval.json"
     params: gt=lambda wc: DET["sequences"][wc.seq]["gt"], iou=DET["iou"]
     log: f"{R}/_logs/detect/{{config}}/{{seq}}.eval.log"
     shell:
-        "{input.bin} -q --json detect-eval --gt {params.gt:q} --det {input.det}/det.txt --iou {params.iou}"
+        "{M.crowdslam} -q --json detect-eval --gt {params.gt:q} --det {input.det}/det.txt --iou {params.iou}"
         " > {output}.tmp 2> {log} && mv {output}.tmp {output}"
 
 

@@ -86,7 +86,13 @@ class Matrix:
         self.timing_threads = int(c.get("timing_threads", 2))
         self.mem_mb = int(c.get("mem_mb", 1024))
         self.runtime_min = int(c.get("runtime_min", 30))
-        self.exclusive = bool(c.get("exclusive_timing", False))
+        # files: the binary, settings and on-disk datasets are input files (a shared file system);
+        # params: they are not (a cluster without one, e.g. Kubernetes with a remote provider): a
+        # fingerprint (build_id, the settings' contents, the dataset's manifest when readable) is a param.
+        self.inputs = c.get("inputs", "files")
+        if self.inputs not in ("files", "params"):
+            raise MatrixError(f"inputs {self.inputs!r}: files or params")
+        self.build_id = str(c.get("build_id", ""))
         self.compare_by = c.get("compare_by", "dataset")
         if self.compare_by not in ("dataset", "settings", "options"):
             raise MatrixError(f"compare_by {self.compare_by!r}: dataset, settings or options")
@@ -194,6 +200,19 @@ class Matrix:
             args.append("--sequential")
         args += d["args"] + self.options[c["options"]]
         return [a.replace("{dataset}", d["path"]) for a in args]
+
+    def fingerprint(self, case):
+        """What the result of a case depends on, as text (inputs: params)."""
+        c = self.cases[case]
+        d = self.datasets[c["dataset"]]
+        parts = [f"build {self.build_id}", " ".join(self.run_args(case))]
+        for path in (self.settings_file(case), self.settings[c["settings"]].get("base")):
+            if path and os.path.isfile(path):
+                with open(path, "rb") as f:
+                    parts.append(hashlib.sha256(f.read()).hexdigest())
+        if d["kind"] == "path" and os.path.exists(d["path"]):
+            parts.append(json.loads(dataset_manifest(d["path"]))["sha256"])
+        return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:16]
 
     def threads(self):
         return 1 if self.mode == "accuracy" else self.timing_threads
