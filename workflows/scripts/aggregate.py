@@ -107,11 +107,11 @@ def command_of(matrix):
 def markdown(table):
     m = table["matrix"]
     p = table["provenance"]
-    mode = ("sequential runs (`--sequential`), two at a time on 2 cores" if m["mode"] == "accuracy"
-            else "threaded runs, one at a time")
+    mode = ("sequential runs (`--sequential`, 1 thread each)" if m["mode"] == "accuracy"
+            else "threaded runs (2 threads each)")
     load = p["load_1min"]
     lines = [f"### {m['title']}", "",
-             f"Median (min-max) of {m['runs']} {mode} per case. Command: `{command_of(m)}`.", "",
+             f"Median (min-max) of each case's {m['runs']} {mode}. Command: `{command_of(m)}`.", "",
              f"Measured {p['first']}{'' if p['first'] == p['last'] else ' to ' + p['last']} on {'; '.join(p['machines']) or 'n/a'}; "
              f"load average (1 min) at the start of a run {cell(load, '{:.1f}')}; "
              f"crowdslam {', '.join(p['builds']) or 'n/a'}.", ""]

@@ -40,6 +40,32 @@ def pct(x):
     return "-" if x is None else f"{100 * x:.1f}"
 
 
+def markdown(table):
+    matrix, prov, rows = table["matrix"], table["provenance"], table["configs"]
+    det = matrix["detection"]
+    seqs = list(det["sequences"])
+    files = matrix.get("configfiles") or [f"workflows/matrices/{matrix['matrix']}.yaml"]
+    out = [f"### {matrix['title']}: person detection", "",
+           f"Precision / recall / MODA / MODP in %, IoU {det['iou']}; ms/frame: median detect() time per frame "
+           f"({det['threads']} OpenCV thread), the median of the sequences' medians. Command: "
+           f"`snakemake -s workflows/Snakefile --configfile {' '.join(files)} --cores 2`.", "",
+           f"Measured {prov['first']}{'' if prov['first'] == prov['last'] else ' to ' + str(prov['last'])} on "
+           f"{'; '.join(prov['machines']) or 'n/a'}; load average (1 min) at the start of a job "
+           f"{cell(prov['load_1min'], '{:.1f}')}.", ""]
+    head = ["config"] + [f"{s} P / R / MODA / MODP" for s in seqs] + ["all P / R / MODA / MODP", "ms/frame"]
+    out += ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
+    for config, r in rows.items():
+        cells = [" / ".join(pct(r["sequences"][s][k]) for k in METRICS) if s in r["sequences"] else "n/a"
+                 for s in seqs]
+        allm = " / ".join(pct(r["all"][k]) for k in METRICS) if r["all"] else "n/a"
+        ms = "-" if r["ms_per_frame"] is None else f"{r['ms_per_frame']:.1f}"
+        out.append(f"| `{config}` | " + " | ".join(cells) + f" | {allm} | {ms} |")
+    out.append("")
+    out += [f"- `{c}`: " + ("the sequence's published `det/det.txt`" if r["public"] else
+                            f"`crowdslam detect {' '.join(r['args'])}`") for c, r in rows.items()]
+    return "\n".join(out) + "\n"
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--matrix", required=True)
@@ -84,24 +110,7 @@ def main():
                 w.writerow([config, seq] + ["" if e[k] is None else repr(e[k]) for k in METRICS] +
                            [e["tp"], e["fp"], e["fn"], "" if r["ms_per_frame"] is None else repr(r["ms_per_frame"])])
     with open(tmp + ".md", "w") as f:
-        files = matrix.get("configfiles") or [f"workflows/matrices/{matrix['matrix']}.yaml"]
-        f.write(f"### {matrix['title']}: person detection\n\n"
-                f"Precision / recall / MODA / MODP in %, IoU {det['iou']}; ms/frame: median detect() time per "
-                f"frame ({det['threads']} OpenCV thread), the median of the sequences' medians. Command: "
-                f"`snakemake -s workflows/Snakefile --configfile {' '.join(files)} --cores 2`.\n\n"
-                f"Measured {prov['first']}{'' if prov['first'] == prov['last'] else ' to ' + prov['last']} on {'; '.join(prov['machines']) or 'n/a'}; load "
-                f"average (1 min) at the start of a job {cell(prov['load_1min'], '{:.1f}')}.\n\n")
-        head = ["config"] + [f"{s} P / R / MODA / MODP" for s in seqs] + ["all P / R / MODA / MODP", "ms/frame"]
-        f.write("| " + " | ".join(head) + " |\n|" + " --- |" * len(head) + "\n")
-        for config, r in rows.items():
-            cells = [" / ".join(pct(r["sequences"][s][k]) for k in METRICS) if s in r["sequences"] else "n/a"
-                     for s in seqs]
-            allm = " / ".join(pct(r["all"][k]) for k in METRICS) if r["all"] else "n/a"
-            ms = "-" if r["ms_per_frame"] is None else f"{r['ms_per_frame']:.1f}"
-            f.write(f"| `{config}` | " + " | ".join(cells) + f" | {allm} | {ms} |\n")
-        f.write("\n" + "".join(f"- `{c}`: " + ("the sequence's published `det/det.txt`" if r["public"] else
-                                              f"`crowdslam detect {' '.join(r['args'])}`") + "\n"
-                               for c, r in rows.items()))
+        f.write(markdown(table))
     for ext in ("csv", "md", "json"):
         os.replace(f"{tmp}.{ext}", f"{a.out}.{ext}")
 
