@@ -25,6 +25,7 @@ packages=(
   libjs-chart.js chromium   # report.html inlines Chart.js; the report tests open it in headless Chromium
   libjs-three libcpp-httplib-dev   # the live viewer: three.js served by our own HTTP server
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (build/python) and its tests
+  snakemake   # the evaluation workflow (workflows/) and its tests
 )
 
 missing=()

@@ -24,7 +24,7 @@ namespace crowdslam::app {
 namespace {
 
 // `crowdslam detect`'s defaults without --settings: chosen for detection quality on the MOT sequences
-// (docs/DETECTION.md, scripts/eval_detectors.sh); the model's own default input is in model_zoo.cpp.
+// (docs/DETECTION.md, workflows/matrices/detectors.yaml); the model's own default input is in model_zoo.cpp.
 // The SLAM filter's thresholds are the Detector.* keys of config/*.yaml, chosen for SLAM accuracy.
 // YOLOX-nano COCO rather than ByteTrack-nano (as good on these sequences) because ByteTrack was trained
 // on MOT17: its figures on MOT16/17 sequences would not be a test.

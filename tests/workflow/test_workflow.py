@@ -1,0 +1,140 @@
+"""The evaluation workflow (workflows/): a dry run of every shipped matrix, the smoke matrix end to end
+(its table against the individual run.json / time.json files), and a job killed mid-run.
+
+Environment (set by CTest, tests/workflow/CMakeLists.txt): CROWDSLAM_CLI (the crowdslam binary),
+CROWDSLAM_SOURCE_DIR, CROWDSLAM_SHARED_DIR (../shared), SNAKEMAKE (the snakemake command).
+By hand: CROWDSLAM_CLI=/path/to/crowdslam python3 -m pytest -v -p no:cacheprovider tests/workflow
+"""
+import csv
+import glob
+import json
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import time
+
+import pytest
+
+SOURCE = os.environ.get("CROWDSLAM_SOURCE_DIR") or os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__))))
+CLI = os.environ.get("CROWDSLAM_CLI") or os.path.join(SOURCE, "build", "apps", "crowdslam", "crowdslam")
+SHARED = os.environ.get("CROWDSLAM_SHARED_DIR") or os.environ.get("CROWDSLAM_SHARED") or os.path.join(
+    SOURCE, "..", "shared")
+SNAKEMAKE = os.environ.get("SNAKEMAKE", "snakemake")
+SNAKEFILE = os.path.join(SOURCE, "workflows", "Snakefile")
+MATRICES = sorted(glob.glob(os.path.join(SOURCE, "workflows", "matrices", "*.yaml")))
+sys.path.insert(0, os.path.join(SOURCE, "workflows", "scripts"))
+import aggregate  # noqa: E402
+
+ENV = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+
+pytestmark = pytest.mark.skipif(not os.access(CLI, os.X_OK), reason=f"{CLI} not built")
+
+
+def snakemake(work, matrix, *extra, cli=CLI, env=ENV, **kw):
+    cmd = [SNAKEMAKE, "-s", SNAKEFILE, "--directory", str(work), "--configfile", matrix, "--config",
+           f"results={work}/results", f"crowdslam={cli}", f"shared={SHARED}"] + list(extra)
+    return subprocess.run(cmd, env=env, capture_output=True, text=True, **kw)
+
+
+@pytest.mark.parametrize("matrix", MATRICES, ids=[os.path.basename(m)[:-5] for m in MATRICES])
+def test_dry_run(tmp_path, matrix):
+    if "{shared}" in open(matrix).read() and not os.path.isdir(os.path.join(SHARED, "data")):
+        pytest.skip(f"{SHARED}/data not found")
+    r = snakemake(tmp_path, matrix, "-n", "-q")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "Job stats" in r.stdout + r.stderr
+
+
+def smoke_matrix():
+    return os.path.join(SOURCE, "workflows", "matrices", "smoke.yaml")
+
+
+def medians_from_runs(results):
+    """Medians computed here, from each complete run directory's own files."""
+    out = {}
+    for case_dir in sorted(glob.glob(os.path.join(results, "smoke", "*.*.*"))):
+        values = {}
+        for run in sorted(glob.glob(os.path.join(case_dir, "[0-9]*"))):
+            if not os.path.isdir(run) or ".tmp-" in run:
+                continue
+            doc = json.load(open(os.path.join(run, "run.json")))
+            timing = json.load(open(os.path.join(run, "time.json")))
+            s, a = doc["summary"], doc["accuracy"]
+            for key, value in (("ate_m", a["ate_rmse_m"]), ("rpe_m_per_s", a["rpe_trans_rmse_m_per_s"]),
+                               ("tracked_percent", s["tracked_percent"]), ("map_resets", s["map_resets"]),
+                               ("fps", s["throughput_fps"]), ("cpu_s_per_frame", timing["cpu_s"] / s["frames"]),
+                               ("peak_rss_mb", timing["peak_rss_kb"] / 1024)):
+                values.setdefault(key, []).append(value)
+        out[os.path.basename(case_dir)] = {k: statistics.median(v) for k, v in values.items()}
+    return out
+
+
+def test_smoke_end_to_end(tmp_path):
+    r = snakemake(tmp_path, smoke_matrix(), "--cores", "2", timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    results = tmp_path / "results"
+    table = json.load(open(results / "smoke" / "table.json"))
+    rows = {row["case"]: row for row in csv.DictReader(open(results / "smoke" / "table.csv"))}
+    expected = medians_from_runs(results)
+    assert len(expected) == 4 and set(rows) == set(expected) == set(table["cases"])
+    for case, medians in expected.items():
+        assert table["cases"][case]["complete"] == 2 and rows[case]["runs"] == "2"
+        for key, value in medians.items():
+            assert table["cases"][case]["stats"][key]["median"] == pytest.approx(value, rel=1e-12), (case, key)
+            assert float(rows[case][f"{key}_median"]) == pytest.approx(value, rel=1e-12), (case, key)
+    md = open(results / "smoke" / "table.md").read()
+    assert "| `room_s1.default.gt_boxes` | 2/2 |" in md and "Measured " in md
+    for group in ("room_s1", "room_s2"):
+        page = results / "smoke" / "compare" / f"{group}.html"
+        assert page.stat().st_size > 10000
+
+
+def test_interrupted_job_leaves_no_result(tmp_path):
+    # A wrapper around crowdslam that, for one run, hangs after crowdslam has finished: the job is killed
+    # with a complete run.json in its staging directory, the most tempting partial result there is.
+    hang = "room_s2.default.no_filter/2.tmp-"
+    flag = tmp_path / "reached"
+    wrapper = tmp_path / "crowdslam-wrapper"
+    wrapper.write_text(f"""#!/usr/bin/env bash
+"{CLI}" "$@" || exit $?
+if [[ -n "${{HANG_AT:-}}" && "$*" == *"$HANG_AT"* ]]; then touch "{flag}"; exec sleep 120; fi
+""")
+    wrapper.chmod(0o755)
+    cmd = [SNAKEMAKE, "-s", SNAKEFILE, "--directory", str(tmp_path), "--configfile", smoke_matrix(),
+           "--config", f"results={tmp_path}/results", f"crowdslam={wrapper}", "--cores", "1"]
+    p = subprocess.Popen(cmd, env=dict(ENV, HANG_AT=hang), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                         start_new_session=True)
+    deadline = time.monotonic() + 120
+    while not flag.exists() and time.monotonic() < deadline and p.poll() is None:
+        time.sleep(0.1)
+    assert flag.exists(), "the job to interrupt never ran"
+    os.killpg(p.pid, signal.SIGKILL)  # snakemake, the job script, the wrapper: all at once
+    p.wait()
+    smoke = tmp_path / "results" / "smoke"
+    case = smoke / "room_s2.default.no_filter"
+    staging = glob.glob(str(case / "2.tmp-*"))
+    assert staging and json.load(open(os.path.join(staging[0], "out", "run.json")))["end_state"] == "completed"
+    assert not (case / "2").exists()
+    finished = {d: open(os.path.join(d, "job.json")).read() for d in glob.glob(str(smoke / "*.*.*" / "[0-9]"))}
+    # What aggregation counts now: only the finished runs, none from the staging directory.
+    r = subprocess.run([sys.executable, os.path.join(SOURCE, "workflows", "scripts", "aggregate.py"), "--matrix",
+                        str(smoke / "matrix.json"), "--results", str(smoke), "--out", str(tmp_path / "partial")],
+                       env=ENV, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    partial = json.load(open(tmp_path / "partial.json"))
+    counted = [run["dir"] for c in partial["cases"].values() for run in c["runs"]]
+    assert len(counted) == len(finished) and not any(".tmp-" in d for d in counted)
+    assert partial["cases"]["room_s2.default.no_filter"]["complete"] <= 1
+    # A rerun (after the lock the killed snakemake left) completes it and redoes nothing else.
+    subprocess.run(cmd + ["--unlock"], env=ENV, capture_output=True, check=True)
+    r = subprocess.run(cmd + ["--rerun-incomplete"], env=ENV, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert (case / "2" / "job.json").exists() and not glob.glob(str(case / "2.tmp-*"))
+    for d, text in finished.items():
+        assert open(os.path.join(d, "job.json")).read() == text, f"{d} was run again"
+    table = json.load(open(smoke / "table.json"))
+    assert all(c["complete"] == 2 for c in table["cases"].values())
+    assert aggregate.run_figures(str(case / "2")) is not None
