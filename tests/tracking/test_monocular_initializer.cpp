@@ -248,11 +248,14 @@ TEST_F(MonocularInit, APlacedMapLandsWhereTheMotionSaysAtItsScale) {
   placement.reference_cam_from_world = reference_pose;
   placement.predicted_baseline = (world_from_cam(6).translation() - world_from_cam(0).translation()).norm();
   placement.expected_median_depth = 2.0;
+  placement.parent = existing;
   const auto keyframes = tracking::build_initial_map(map, *init, current, initializer.options(), &placement);
   ASSERT_TRUE(keyframes.has_value());
   EXPECT_TRUE(placement.scaled_by_baseline);
   EXPECT_EQ(map.num_keyframes(), 3u);
   const auto& [kf1, kf2] = *keyframes;
+  EXPECT_EQ(kf1->parent(), existing);  // one spanning tree, no parent cycle between the two
+  EXPECT_EQ(kf2->parent(), kf1);
   EXPECT_LT((kf1->cam_from_world().translation() - reference_pose.translation()).norm(), 1e-9);
   EXPECT_LT(rotation_error_deg(kf2->cam_from_world(), current_pose), 0.5);
   const double centre_error = (kf2->world_from_cam().translation() - world_from_cam(6).translation()).norm();
@@ -270,6 +273,7 @@ TEST_F(MonocularInit, APlacedMapLandsWhereTheMotionSaysAtItsScale) {
   map::Map other;
   map::Frame again = make_frame(6, synth::render_frame(*scene_, 6).colour);
   placement.predicted_baseline = 0.01 * placement.expected_median_depth;
+  placement.parent = nullptr;
   ASSERT_TRUE(tracking::build_initial_map(other, *init, again, initializer.options(), &placement).has_value());
   EXPECT_FALSE(placement.scaled_by_baseline);
   EXPECT_NEAR(other.keyframes().front()->scene_median_depth(), 2.0, 1e-3);

@@ -152,6 +152,7 @@ std::optional<std::pair<std::shared_ptr<map::KeyFrame>, std::shared_ptr<map::Key
   auto kf2 =
       std::make_shared<map::KeyFrame>(map.next_keyframe_id(), current.id, current.timestamp_s, current.camera,
                                       current.levels, current.features, init.current_from_reference);
+  if (placement != nullptr && placement->parent) kf1->restore_parent(placement->parent);
   map.add_keyframe(kf1);
   map.add_keyframe(kf2);
   std::vector<std::shared_ptr<map::MapPoint>> points;
@@ -220,6 +221,10 @@ std::optional<std::pair<std::shared_ptr<map::KeyFrame>, std::shared_ptr<map::Key
       for (const auto& point : points) map.erase_map_point(point->id);
       map.erase_keyframe(kf2->id);
       map.erase_keyframe(kf1->id);
+      // Keyframes hold strong links to their points and parent, points to their keyframes: cut them.
+      if (placement->parent) placement->parent->erase_child(kf1->id);
+      kf2->release_links();
+      kf1->release_links();
     }
     return std::nullopt;
   }

@@ -87,6 +87,9 @@ struct InitialMapPlacement {
   double predicted_baseline = 0;
   double expected_median_depth = 1;
   double min_baseline_share = 0.02;
+  // The keyframe of the existing map the reference keyframe hangs from in the spanning tree (else the
+  // two new keyframes would be each other's parent, a cycle that is never freed).
+  std::shared_ptr<map::KeyFrame> parent;
   bool scaled_by_baseline = false;  // output: which of the two fixed the scale
   double scale = 1;                 // output: the scale applied to the two-view reconstruction
 };

@@ -310,6 +310,7 @@ class Tracker {
   struct Reanchor {
     BridgeMotion motion;          // from the last pose before the loss
     double median_depth = 1;      // of the reference keyframe then
+    std::shared_ptr<map::KeyFrame> keyframe;  // that reference keyframe (the new part's parent)
   };
   std::optional<Reanchor> reanchor_;  // while lost in a monocular map that may be re-anchored
   struct RecentPose {

@@ -29,7 +29,7 @@ void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion) {
   const auto reference = reference_keyframe_ && !reference_keyframe_->is_bad() ? reference_keyframe_ : last_keyframe_;
   const float depth = reference ? reference->scene_median_depth() : 0.0F;
   if (!(depth > 0)) return;
-  reanchor_ = Reanchor{*motion, depth};
+  reanchor_ = Reanchor{*motion, depth, reference};
 }
 
 bool Tracker::reanchor(map::Frame& frame) {
@@ -49,6 +49,16 @@ bool Tracker::reanchor(map::Frame& frame) {
   placement.predicted_baseline =
       (current_pose.inverse().translation() - placement.reference_cam_from_world.inverse().translation()).norm();
   placement.expected_median_depth = reanchor_->median_depth;
+  placement.parent = reanchor_->keyframe;
+  if (!placement.parent || placement.parent->is_bad()) {
+    const auto keyframes = map_->keyframes();
+    for (auto it = keyframes.rbegin(); it != keyframes.rend(); ++it) {
+      if (!(*it)->is_bad()) {
+        placement.parent = *it;
+        break;
+      }
+    }
+  }
   const auto keyframes = build_initial_map(*map_, *init, frame, options_.monocular_init, &placement);
   if (!keyframes) {
     reanchor_initializer_.reset();
