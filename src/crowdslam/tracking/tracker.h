@@ -217,6 +217,10 @@ class Tracker {
  private:
   bool initialize(map::Frame& frame);
   bool initialize_monocular(map::Frame& frame);  // tracker_monocular.cpp
+  // The two keyframes of a two-view map (initialisation or re-anchoring) to the mapper; tracking goes on
+  // from the second, with `points` as the local map (tracker_monocular.cpp).
+  void track_from_two_views(const std::shared_ptr<map::KeyFrame>& first, const std::shared_ptr<map::KeyFrame>& second,
+                            map::Frame& frame, std::vector<std::shared_ptr<map::MapPoint>> points);
   // After a monocular initialisation from `init_frame`: the earlier frames in frames_before_init_ that
   // the new map localises (tracker_monocular.cpp).
   std::vector<std::pair<uint64_t, geometry::SE3>> localize_frames_before_init(const map::Frame& init_frame,

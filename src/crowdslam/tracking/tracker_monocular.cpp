@@ -38,6 +38,16 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
     return false;
   }
   const auto& [first, second] = *keyframes;
+  track_from_two_views(first, second, frame, map_->map_points());
+  recovered_before_init_ = localize_frames_before_init(frame, init->reference->id);
+  frames_before_init_.clear();
+  monocular_initializer_.reset();
+  return true;
+}
+
+void Tracker::track_from_two_views(const std::shared_ptr<map::KeyFrame>& first,
+                                   const std::shared_ptr<map::KeyFrame>& second, map::Frame& frame,
+                                   std::vector<std::shared_ptr<map::MapPoint>> points) {
   mapper_->insert_keyframe(first);
   mapper_->insert_keyframe(second);
   last_keyframe_ = second;
@@ -46,13 +56,9 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
   reference_keyframe_ = second;
   frame.reference_keyframe = second;
   local_keyframes_ = {first, second};
-  local_points_ = map_->map_points();
+  local_points_ = std::move(points);
   inliers_in_local_map_ = static_cast<int>(local_points_.size());
   velocity_.reset();  // the next frame is tracked against the reference keyframe
-  recovered_before_init_ = localize_frames_before_init(frame, init->reference->id);
-  frames_before_init_.clear();
-  monocular_initializer_.reset();
-  return true;
 }
 
 namespace {

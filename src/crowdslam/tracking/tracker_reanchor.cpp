@@ -73,17 +73,7 @@ bool Tracker::reanchor(map::Frame& frame) {
       "from the {} ({} points)",
       init->reference->id, frame.id, frame.timestamp_s - motion.anchor_s, placement.scale,
       placement.scaled_by_baseline ? "predicted baseline" : "scene depth", second->tracked_map_points(1));
-  mapper_->insert_keyframe(first);
-  mapper_->insert_keyframe(second);
-  last_keyframe_ = second;
-  last_keyframe_frame_id_ = frame.id;
-  last_keyframe_indices_.clear();
-  reference_keyframe_ = second;
-  frame.reference_keyframe = second;
-  local_keyframes_ = {first, second};
-  local_points_ = second->valid_map_points();
-  inliers_in_local_map_ = static_cast<int>(local_points_.size());
-  velocity_.reset();  // the next frame is tracked against the reference keyframe
+  track_from_two_views(first, second, frame, second->valid_map_points());
   frame.discard_outliers();
   reanchor_initializer_.reset();
   reanchor_.reset();
