@@ -48,6 +48,20 @@ def test_dry_run(tmp_path, matrix):
     assert "Job stats" in r.stdout + r.stderr
 
 
+def test_a_list_of_grids_expands_to_the_union_of_their_products(tmp_path):
+    import matrix as mx
+    config = {"matrix": "grids", "datasets": {"{crowd}_{people}": {
+        "grid": [{"crowd": ["passing", "standing"], "people": [8, 16]}, {"crowd": ["near"], "people": [8]}],
+        "synth": "--crowd {crowd} --people {people}"}}, "options": {"default": ""}}
+    m = mx.Matrix(config, repo=SOURCE, results=str(tmp_path))
+    assert sorted(m.datasets) == ["near_8", "passing_16", "passing_8", "standing_16", "standing_8"]
+    assert m.datasets["near_8"]["synth"] == ["--crowd", "near", "--people", "8"]
+    assert len(m.cases) == 5
+    config["datasets"]["{crowd}_{people}"]["grid"] = [{"crowd": ["near"]}, ["people"]]
+    with pytest.raises(mx.MatrixError, match="grid"):
+        mx.Matrix(config, repo=SOURCE, results=str(tmp_path))
+
+
 def smoke_matrix():
     return os.path.join(SOURCE, "workflows", "matrices", "smoke.yaml")
 

@@ -56,10 +56,15 @@ def _grid(entries, kind):
     for name, entry in (entries or {}).items():
         entry = dict(entry) if isinstance(entry, dict) else entry
         if isinstance(entry, dict) and "grid" in entry:
-            grid = entry.pop("grid")
-            axes = list(grid)
-            for values in itertools.product(*(grid[a] for a in axes)):
-                sub = _Keep(zip(axes, values))
+            grids = entry.pop("grid")
+            combos = []  # a grid, or a list of grids: the union of their products, in order
+            for grid in grids if isinstance(grids, list) else [grids]:
+                if not isinstance(grid, dict) or not grid:
+                    raise MatrixError(f"{kind} {name!r}: grid: a mapping of axes to lists, or a list of them")
+                axes = list(grid)
+                combos += [list(zip(axes, values)) for values in itertools.product(*(grid[a] for a in axes))]
+            for combo in combos:
+                sub = _Keep(combo)
                 fill = lambda v: v.format_map(sub) if isinstance(v, str) else (
                     [fill(x) for x in v] if isinstance(v, list) else (
                         {k: fill(x) for k, x in v.items()} if isinstance(v, dict) else v))
