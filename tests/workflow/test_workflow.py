@@ -62,6 +62,33 @@ def test_a_list_of_grids_expands_to_the_union_of_their_products(tmp_path):
         mx.Matrix(config, repo=SOURCE, results=str(tmp_path))
 
 
+def test_the_crowd_table_puts_each_crowd_case_beside_its_empty_room():
+    import publish
+
+    def case(dataset, options, ate, baseline=None, complete=5):
+        stats = {k: {"median": v} for k, v in (("tracked_percent", 97.5), ("map_resets", 0), ("reanchors", 1),
+                                                ("bridged_frames", 4), ("ate_m", ate), ("fps", 50.0))}
+        return ({"dataset": dataset, "options": options, "baseline": baseline},
+                {"complete": complete, "stats": stats, "ate_ratio": ate / 0.004 if baseline and ate else None})
+    cases = {"standing_8_s5.default.body_mono": case("standing_8_s5", "body_mono", 0.02, "standing_8_s5_empty.default.empty_mono"),
+             "standing_8_s5_empty.default.empty_mono": case("standing_8_s5_empty", "empty_mono", 0.004),
+             "passing_16_s5_stereo.default.gt": case("passing_16_s5_stereo", "gt", 0.008, "passing_16_s5_stereo_empty.default.empty"),
+             "passing_16_s5_stereo_empty.default.empty": case("passing_16_s5_stereo_empty", "empty", 0.004),
+             "passing_16_s5.default.yolox": case("passing_16_s5", "yolox", None, "passing_16_s5_empty.default.empty", 0)}
+    table = {"matrix": {"matrix": "synthetic_crowd", "mode": "timing", "runs": 5,
+                        "cases": {k: v[0] for k, v in cases.items()}},
+             "cases": {k: v[1] for k, v in cases.items()},
+             "provenance": {"last": "2026-12-06", "machines": ["vm: AMD EPYC, 2 of 2 cores"], "builds": ["x"]}}
+    rows = [line for line in publish.crowds_table(table).splitlines() if line.startswith("| ") and "---" not in line][1:]
+    # Passing before standing; the empty rooms are not rows of their own but the column beside their crowd.
+    assert [r.split(" | ")[:5] for r in rows] == [["| passing", "16", "5", "rgbd", "yolox"],
+                                                ["| passing", "16", "5", "stereo", "gt"],
+                                                ["| standing", "8", "5", "mono", "body"]]
+    assert rows[1].split(" | ")[10:13] == ["0.0080", "0.0040", "2.0x"]
+    assert rows[2].split(" | ")[5:13] == ["5/5", "97.5", "0", "1", "4", "0.0200", "0.0040", "5.0x"]
+    assert rows[0].split(" | ")[5] == "0/5" and "n/a" in rows[0]
+
+
 def smoke_matrix():
     return os.path.join(SOURCE, "workflows", "matrices", "smoke.yaml")
 

@@ -9,7 +9,9 @@ workflows/matrices/MATRIX.yaml`), the table is stored as docs/results/MATRIX.jso
 MATRIX.detect.json), replacing the one stored before. Then docs/RESULTS.md is written from every stored
 table (with the machine, dates and command of each) and the README's table between
 <!-- results:begin --> and <!-- results:end --> from the rows published.yaml names.
-docs/results/build_times.json comes from scripts/measure_build_times.py.
+docs/results/build_times.json comes from scripts/measure_build_times.py. The crowd matrix named by
+published.yaml's `crowds:` is also shown in docs/CROWDS.md between <!-- crowds:begin --> and
+<!-- crowds:end -->, one row per crowd case (profile, people, sensor, detector) beside its empty room.
 """
 import argparse
 import json
@@ -25,6 +27,7 @@ from matrix import repo_root  # noqa: E402
 REPO = repo_root()
 STORE = os.path.join(REPO, "docs", "results")
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+CROWDS_BEGIN, CROWDS_END = "<!-- crowds:begin -->", "<!-- crowds:end -->"
 
 
 def load_yaml(path):
@@ -121,15 +124,57 @@ def results_md(published):
     return "\n".join(out)
 
 
-def write_readme(table):
-    path = os.path.join(REPO, "README.md")
+def crowd_case(dataset, options):
+    """(profile, people, seed, sensor, detector) of a synthetic_crowd case: datasets PROFILE_PEOPLE_sSEED
+    [_stereo], options DETECTOR[_mono]."""
+    parts = dataset.split("_")
+    sensor = "stereo" if parts[-1] == "stereo" else ("mono" if options.endswith("_mono") else "rgbd")
+    return parts[0], int(parts[1]), parts[2][1:], sensor, options[:-5] if options.endswith("_mono") else options
+
+
+def crowds_table(table):
+    """The crowd matrix in docs/CROWDS.md: a row per crowd case, with the empty room's ATE beside it."""
+    m, cases = table["matrix"], table["cases"]
+    lines = [f"Medians of {m['runs']} {'threaded' if m['mode'] == 'timing' else 'sequential'} runs per case; "
+             f"measured {table['provenance']['last']} on {'; '.join(table['provenance']['machines'])}, "
+             f"crowdslam {', '.join(table['provenance']['builds'])}. Command: `{command(m['matrix'])}`; every "
+             "figure with its range: [RESULTS.md](RESULTS.md).", "",
+             "| profile | people | seed | sensor | detector | runs | tracked % | map resets | re-anchorings | "
+             "bridged | ATE (m) | empty room ATE (m) | ATE / empty | frames/s |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    rows = []
+    for name, case in m["cases"].items():
+        base = case.get("baseline")
+        if not base:
+            continue  # an empty room: shown beside its crowd
+        c, b = cases[name], cases.get(base)
+        s = c["stats"]
+        empty = b and b["stats"]["ate_m"]["median"]
+        rows.append((crowd_case(case["dataset"], case["options"]), [
+            f"{c['complete']}/{m['runs']}", fmt(s["tracked_percent"]["median"], "{:.1f}"),
+            fmt(s["map_resets"]["median"], "{:g}"), fmt(s["reanchors"]["median"], "{:g}"),
+            fmt(s["bridged_frames"]["median"], "{:g}"), fmt(s["ate_m"]["median"], "{:.4f}"), fmt(empty, "{:.4f}"),
+            fmt(c.get("ate_ratio"), "{:.1f}x"), fmt(s["fps"]["median"], "{:.1f}")]))
+    profiles = ["passing", "standing", "near", "blackout"]
+    order = lambda r: (profiles.index(r[0][0]) if r[0][0] in profiles else 9, r[0][1], r[0][2],
+                       ["rgbd", "stereo", "mono"].index(r[0][3]), r[0][4])
+    for key, cells in sorted(rows, key=order):
+        lines.append("| " + " | ".join([key[0], str(key[1]), key[2], key[3], key[4]] + cells) + " |")
+    return "\n".join(lines)
+
+
+def replace_block(path, begin, end, content):
     text = open(path).read()
-    if BEGIN not in text or END not in text:
-        sys.exit(f"publish: README.md has no {BEGIN} ... {END} block")
-    head, rest = text.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
+    if begin not in text or end not in text:
+        sys.exit(f"publish: {os.path.relpath(path, REPO)} has no {begin} ... {end} block")
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
     with open(path, "w") as f:
-        f.write(head + BEGIN + "\n" + table + "\n" + END + tail)
+        f.write(head + begin + "\n" + content + "\n" + end + tail)
+
+
+def write_readme(table):
+    replace_block(os.path.join(REPO, "README.md"), BEGIN, END, table)
 
 
 def main():
@@ -149,6 +194,9 @@ def main():
     with open(os.path.join(REPO, "docs", "RESULTS.md"), "w") as f:
         f.write(results_md(published) + "\n")
     write_readme(readme_table(published["readme"]))
+    crowds = published.get("crowds") and stored(published["crowds"] + ".json")
+    if crowds:
+        replace_block(os.path.join(REPO, "docs", "CROWDS.md"), CROWDS_BEGIN, CROWDS_END, crowds_table(crowds))
     print("publish: wrote docs/RESULTS.md and the README's results table", file=sys.stderr)
 
 
