@@ -152,3 +152,31 @@ TEST(RunBlackout, MonocularReanchorsIntoTheSameMapWithTheScaleOfBefore) {
   EXPECT_GE(without.json["summary"]["map_resets"].get<int>(), 1);
   EXPECT_EQ(without.json["summary"]["reanchors"].get<int>(), 0);
 }
+
+// Re-anchoring is counted from the loss, as the new-map clock: after a bridge, from when the view cleared.
+// With a window shorter than the blackout's bridge, the window counted from the last pose before it would
+// be over by then, and a new map would start.
+TEST(RunBlackout, MonocularReanchoringIsCountedFromWhenTheViewCleared) {
+  test::TempDir tmp;
+  const Blackout b = make_blackout(tmp);
+  const auto summary = run_on(b, tmp / "mono", "\nTracking.reanchor_max_s: 1.0\n", io::SensorKind::kMonocular);
+  const auto& doc = summary.json;
+  double last_bridged_s = -1;
+  double last_pose_before_s = -1;
+  double reanchor_s = -1;
+  for (const auto& f : doc["frames"]) {
+    const double t = f["timestamp"].get<double>();
+    if (f["method"] == "reanchor") {
+      reanchor_s = t;
+      break;
+    }
+    if (f["state"] == "bridged") last_bridged_s = t;
+    if (f["state"] == "ok" && last_bridged_s < 0) last_pose_before_s = t;
+  }
+  ASSERT_GT(last_bridged_s, 0) << "the blackout was not bridged";
+  ASSERT_GT(reanchor_s, 0) << "not re-anchored";
+  EXPECT_GT(reanchor_s - last_pose_before_s, 1.0);  // beyond the window, counted from the last pose
+  EXPECT_LE(reanchor_s - last_bridged_s, 1.0 + 1e-6);
+  EXPECT_EQ(doc["summary"]["map_resets"].get<int>(), 0);
+  EXPECT_EQ(doc["segments"].size(), 1u);
+}

@@ -335,7 +335,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       result.bridged_cam_from_world = frame.cam_from_world;
     } else {
       if (options_.monocular && lost_frames_ == 0) {
-        start_reanchor(after_bridge ? bridge_motion_ : recent_motion(frame, velocity_at_start));
+        start_reanchor(after_bridge ? bridge_motion_ : recent_motion(frame, velocity_at_start), frame.timestamp_s);
       }
       velocity_.reset();
       bridge_motion_.reset();

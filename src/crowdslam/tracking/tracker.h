@@ -84,8 +84,9 @@ struct TrackerOptions {
   int new_map_after_lost_min_frames = 3;
   // Monocular re-anchoring (docs/CROWDS.md#monocular-re-anchoring): lost in a map of more than
   // reset_if_lost_within_keyframes keyframes, each frame is also offered to a two-view initialisation
-  // (relocalisation is tried first, as always). When one succeeds within `reanchor_max_s` of the last
-  // pose, its two keyframes join the same map (method "reanchor"): placed where the motion tracked before
+  // (relocalisation is tried first, as always). When one succeeds within `reanchor_max_s` of the loss
+  // (after a bridge: of when the view cleared, as the new-map clock), its two keyframes join the same map
+  // (method "reanchor"): placed where the motion tracked before
   // the loss puts the initializer's reference frame, and scaled so that the two views' baseline is the
   // one that motion predicts (by the last reference keyframe's median scene depth when the camera barely
   // moved). No new map is started meanwhile; after `reanchor_max_s` the new-map rule above applies.
@@ -279,7 +280,7 @@ class Tracker {
   // Monocular re-anchoring (TrackerOptions::reanchor_max_s, tracker_reanchor.cpp): remembers the motion
   // and scene depth at the loss; then offers each lost frame to the two-view initialisation and, when it
   // succeeds, adds its two keyframes to the map where that motion puts them. True when `frame` is tracked.
-  void start_reanchor(const std::optional<BridgeMotion>& motion);
+  void start_reanchor(const std::optional<BridgeMotion>& motion, double lost_since_s);
   bool reanchor(map::Frame& frame);
 
   TrackerOptions options_;
@@ -313,6 +314,7 @@ class Tracker {
   std::optional<BridgeMotion> bridge_motion_;  // while bridging
   struct Reanchor {
     BridgeMotion motion;          // from the last pose before the loss
+    double lost_since_s = 0;      // the first lost frame (after a bridge: when the view cleared)
     double median_depth = 1;      // of the reference keyframe then
     std::shared_ptr<map::KeyFrame> keyframe;  // that reference keyframe (the new part's parent)
   };

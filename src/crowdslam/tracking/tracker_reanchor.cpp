@@ -21,7 +21,7 @@ MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOpt
   return options;
 }
 
-void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion) {
+void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double lost_since_s) {
   reanchor_.reset();
   reanchor_initializer_.reset();
   if (options_.reanchor_max_s <= 0 || !motion || map_loaded_ || localization_only_) return;
@@ -29,12 +29,13 @@ void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion) {
   const auto reference = reference_keyframe_ && !reference_keyframe_->is_bad() ? reference_keyframe_ : last_keyframe_;
   const float depth = reference ? reference->scene_median_depth() : 0.0F;
   if (!(depth > 0)) return;
-  reanchor_ = Reanchor{*motion, depth, reference};
+  reanchor_ = Reanchor{*motion, lost_since_s, depth, reference};
 }
 
 bool Tracker::reanchor(map::Frame& frame) {
-  if (frame.timestamp_s - reanchor_->motion.anchor_s > options_.reanchor_max_s) {
-    spdlog::info("monocular re-anchoring given up {:.1f} s after the last pose", options_.reanchor_max_s);
+  // Counted from the loss, like the new-map clock: after a bridge, from when the view cleared.
+  if (frame.timestamp_s - reanchor_->lost_since_s > options_.reanchor_max_s) {
+    spdlog::info("monocular re-anchoring given up {:.1f} s after tracking was lost", options_.reanchor_max_s);
     reanchor_.reset();
     reanchor_initializer_.reset();
     return false;
