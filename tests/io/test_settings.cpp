@@ -142,6 +142,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.feature_budget.factors = {1.0, 1.25, 3.0};
   s.output.trajectory_format = "kitti";
   s.tracking.odometry_bridge_min_inliers = 0;
+  s.tracking.reanchor_max_s = 1.5;
   s.ground.enabled = true;
   s.ground.keyframe_sigma = 0.1 + 0.2;
   TempDir dir;
@@ -154,6 +155,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   EXPECT_EQ(back.detector.resize, "letterbox");
   EXPECT_EQ(back.camera.k1, 0.1 + 0.2);
   EXPECT_EQ(back.tracking.odometry_bridge_min_inliers, 0);
+  EXPECT_EQ(back.tracking.reanchor_max_s, 1.5);
   EXPECT_TRUE(back.ground.enabled);
   EXPECT_EQ(back.ground.keyframe_sigma, 0.1 + 0.2);
   // A monocular settings object without rectification also survives.
