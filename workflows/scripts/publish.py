@@ -197,7 +197,8 @@ def main():
     crowds = published.get("crowds") and stored(published["crowds"] + ".json")
     if crowds:
         replace_block(os.path.join(REPO, "docs", "CROWDS.md"), CROWDS_BEGIN, CROWDS_END, crowds_table(crowds))
-    print("publish: wrote docs/RESULTS.md and the README's results table", file=sys.stderr)
+    print("publish: wrote docs/RESULTS.md, the README's results table"
+          + (" and docs/CROWDS.md's crowd table" if crowds else ""), file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -86,10 +86,10 @@ struct TrackerOptions {
   // reset_if_lost_within_keyframes keyframes, each frame is also offered to a two-view initialisation
   // (relocalisation is tried first, as always). When one succeeds within `reanchor_max_s` of the loss
   // (after a bridge: of when the view cleared, as the new-map clock), its two keyframes join the same map
-  // (method "reanchor"): placed where the motion tracked before
-  // the loss puts the initializer's reference frame, and scaled so that the two views' baseline is the
-  // one that motion predicts (by the last reference keyframe's median scene depth when the camera barely
-  // moved). No new map is started meanwhile; after `reanchor_max_s` the new-map rule above applies.
+  // (method "reanchor"): placed where the motion tracked before the loss puts the initializer's reference
+  // frame, and scaled so that the two views' baseline is the one that motion predicts (by the last
+  // reference keyframe's median scene depth when the camera barely moved). No new map is started
+  // meanwhile; after `reanchor_max_s` the new-map rule above applies.
   // 0 = off.
   double reanchor_max_s = 3.0;
   // RGB-D / stereo: a frame the motion model places with at least this many inliers among the last
