@@ -89,6 +89,34 @@ def test_the_crowd_table_puts_each_crowd_case_beside_its_empty_room():
     assert rows[0].split(" | ")[5] == "0/5" and "n/a" in rows[0]
 
 
+def test_the_detection_table_reads_each_configuration_from_its_detect_arguments():
+    import publish
+
+    def counts(tp, fp, fn):
+        return {"precision": tp / (tp + fp), "recall": tp / (tp + fn), "moda": 1 - (fp + fn) / (tp + fn),
+                "modp": 0.7, "tp": tp, "fp": fp, "fn": fn}
+    detection = {"iou": 0.5, "sequences": {"A": {}, "B": {}}, "configs": {
+        "yolox_raw": {"public": False, "args": ["--model", "yolox", "--input", "416x320", "--confidence", "0.3",
+                                                "--nms", "0.45", "--raw"]},
+        "body_default": {"public": False, "args": ["--input", "160"]},
+        "public": {"public": True, "args": []}}}
+    configs = {"yolox_raw": {"complete": 2, "sequences": {"A": counts(8, 2, 2), "B": counts(1, 0, 3)},
+                             "all": counts(9, 2, 5), "ms_per_frame": 41.25},
+               "body_default": {"complete": 0, "sequences": {}, "all": {}},
+               "public": {"complete": 2, "sequences": {"A": counts(5, 5, 5), "B": counts(4, 0, 0)},
+                          "all": counts(9, 5, 5), "ms_per_frame": None}}
+    table = {"matrix": {"matrix": "detectors", "detection": detection}, "configs": configs,
+             "provenance": {"last": "2026-12-06", "machines": ["vm"]}}
+    rows = [line for line in publish.detection_table(table).splitlines() if line.startswith("| ")][2:]
+    cells = [r.split(" | ") for r in rows]
+    # Model, input, thresholds and NMS stage from the detect arguments; pooled figures from the summed counts.
+    assert cells[0][:4] == ["| yolox", "416x320", "0.3 / 0.45", "before NMS"]
+    assert cells[0][4] == "81.8 / 64.3 / 50.0 / 70.0"  # 9 / 11, 9 / 14, 1 - 7 / 14
+    assert cells[0][5] == "60.0 / 25.0" and cells[0][6] == "41.2 |"
+    assert "not measured" in rows[1]
+    assert cells[2][:4] == ["| MOT15 public det/det.txt", "-", "all", "after NMS"] and cells[2][6] == "n/a |"
+
+
 def smoke_matrix():
     return os.path.join(SOURCE, "workflows", "matrices", "smoke.yaml")
 

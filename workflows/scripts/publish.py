@@ -11,7 +11,9 @@ table (with the machine, dates and command of each) and the README's table betwe
 <!-- results:begin --> and <!-- results:end --> from the rows published.yaml names.
 docs/results/build_times.json comes from scripts/measure_build_times.py. The crowd matrix named by
 published.yaml's `crowds:` is also shown in docs/CROWDS.md between <!-- crowds:begin --> and
-<!-- crowds:end -->, one row per crowd case (profile, people, sensor, detector) beside its empty room.
+<!-- crowds:end -->, one row per crowd case (profile, people, sensor, detector) beside its empty room,
+and the detection matrix named by `detection:` in docs/DETECTION.md between <!-- detection:begin --> and
+<!-- detection:end -->, one row per detector configuration.
 """
 import argparse
 import json
@@ -28,6 +30,7 @@ REPO = repo_root()
 STORE = os.path.join(REPO, "docs", "results")
 BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 CROWDS_BEGIN, CROWDS_END = "<!-- crowds:begin -->", "<!-- crowds:end -->"
+DETECTION_BEGIN, DETECTION_END = "<!-- detection:begin -->", "<!-- detection:end -->"
 
 
 def load_yaml(path):
@@ -163,6 +166,43 @@ def crowds_table(table):
     return "\n".join(lines)
 
 
+def detection_config(config):
+    """(model, input, "conf / NMS", boxes) of a detection configuration from its `crowdslam detect` args."""
+    if config["public"]:
+        return "MOT15 public det/det.txt", "-", "all", "after NMS"
+    args, values = config["args"], {}
+    for flag, value in zip(args, args[1:] + [""]):
+        if flag.startswith("--") and not value.startswith("--"):
+            values[flag[2:]] = value
+    return (values.get("model", "body"), values.get("input", "default"),
+            f"{values.get('confidence', '0.2')} / {values.get('nms', '0.1')}",
+            "before NMS" if "--raw" in args else "after NMS")
+
+
+def detection_table(table):
+    """The detection matrix in docs/DETECTION.md: a row per configuration, pooled and per sequence."""
+    m, configs = table["matrix"], table["configs"]
+    sequences = list(m["detection"]["sequences"])
+    pct = lambda v: fmt(None if v is None else 100 * v, "{:.1f}")
+    lines = [f"IoU {m['detection']['iou']}; figures in %; \"pooled\" adds up the counts of the sequences. "
+             f"ms/frame: the median over the sequences of the median `detect()` time per frame, one OpenCV "
+             f"thread, two jobs at a time. Measured {table['provenance']['last']} on "
+             f"{'; '.join(table['provenance']['machines'])}. Command: `{command(m['matrix'])}`.", "",
+             "| model | input | conf / NMS | boxes | pooled P / R / MODA / MODP | MODA: "
+             + " / ".join(sequences) + " | ms/frame |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    for name, c in configs.items():
+        if not c.get("complete"):
+            lines.append(f"| `{name}` | not measured | | | | | |")
+            continue
+        a = c["all"]
+        pooled = " / ".join(pct(a.get(k)) for k in ("precision", "recall", "moda", "modp"))
+        moda = " / ".join(pct(c["sequences"].get(s, {}).get("moda")) for s in sequences)
+        model, size, thresholds, boxes = detection_config(m["detection"]["configs"][name])
+        lines.append(f"| {model} | {size} | {thresholds} | {boxes} | {pooled} | {moda} | "
+                     f"{fmt(c.get('ms_per_frame'), '{:.1f}')} |")
+    return "\n".join(lines)
+
+
 def replace_block(path, begin, end, content):
     text = open(path).read()
     if begin not in text or end not in text:
@@ -197,8 +237,13 @@ def main():
     crowds = published.get("crowds") and stored(published["crowds"] + ".json")
     if crowds:
         replace_block(os.path.join(REPO, "docs", "CROWDS.md"), CROWDS_BEGIN, CROWDS_END, crowds_table(crowds))
+    detection = published.get("detection") and stored(published["detection"] + ".detect.json")
+    if detection:
+        replace_block(os.path.join(REPO, "docs", "DETECTION.md"), DETECTION_BEGIN, DETECTION_END,
+                      detection_table(detection))
     print("publish: wrote docs/RESULTS.md, the README's results table"
-          + (" and docs/CROWDS.md's crowd table" if crowds else ""), file=sys.stderr)
+          + (", docs/CROWDS.md's crowd table" if crowds else "")
+          + (", docs/DETECTION.md's accuracy table" if detection else ""), file=sys.stderr)
 
 
 if __name__ == "__main__":
