@@ -33,9 +33,9 @@ ENV = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
 pytestmark = pytest.mark.skipif(not os.access(CLI, os.X_OK), reason=f"{CLI} not built")
 
 
-def snakemake(work, matrix, *extra, cli=CLI, env=ENV, **kw):
+def snakemake(work, matrix, *extra, cli=CLI, env=ENV, config=(), **kw):
     cmd = [SNAKEMAKE, "-s", SNAKEFILE, "--directory", str(work), "--configfile", matrix, "--config",
-           f"results={work}/results", f"crowdslam={cli}", f"shared={SHARED}"] + list(extra)
+           f"results={work}/results", f"crowdslam={cli}", f"shared={SHARED}"] + list(config) + list(extra)
     return subprocess.run(cmd, env=env, capture_output=True, text=True, **kw)
 
 
@@ -159,6 +159,35 @@ def test_smoke_end_to_end(tmp_path):
     for group in ("room_s1", "room_s2"):
         page = results / "smoke" / "compare" / f"{group}.html"
         assert page.stat().st_size > 10000
+
+
+def test_the_slurm_profile_submits_each_run_with_its_resources(tmp_path):
+    # The shipped Slurm profile through Snakemake's own Slurm executor, against stand-in sbatch / sacct /
+    # srun commands (tests/workflow/fake_slurm) that run each job on this machine: the smoke matrix in
+    # timing mode, so the profile's threads and --exclusive for timing runs apply.
+    fake = os.path.join(SOURCE, "tests", "workflow", "fake_slurm")
+    env = dict(ENV, PATH=fake + os.pathsep + ENV.get("PATH", ""), FAKE_SLURM_DIR=str(tmp_path / "slurm"),
+               FAKE_SLURM_ACCOUNT="lab", USER=ENV.get("USER") or "crowdslam")
+    r = snakemake(tmp_path, smoke_matrix(), "--profile", os.path.join(SOURCE, "workflows", "profiles", "slurm"),
+                  "--default-resources", "slurm_account=lab", "slurm_partition=cpu",
+                  "mem_mb=1024", "runtime=30", "--max-status-checks-per-second", "1", config=["mode=timing"], env=env, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    # Each submission's sbatch options (the --wrap command after them repeats the profile's settings).
+    calls = [c.split(" --wrap=")[0] + " " for c in open(tmp_path / "slurm" / "sbatch.log").read().splitlines()]
+    runs = [c for c in calls if c.startswith("-J snakejob_run_timing_")]
+    synth = [c for c in calls if c.startswith("-J snakejob_synth_")]
+    assert len(runs) == 8 and len(synth) == 2 and len(calls) == 10, calls  # tables and pages stay local
+    for c in runs:
+        assert " -A lab -p cpu " in c and " --mem 256 " in c and " --cpus-per-task=3 --exclusive " in c, c
+    for c in synth:
+        assert " --cpus-per-task=1 " in c and "--exclusive" not in c, c
+    table = json.load(open(tmp_path / "results" / "smoke" / "table.json"))
+    assert table["matrix"]["mode"] == "timing"
+    assert sorted(c["complete"] for c in table["cases"].values()) == [2, 2, 2, 2]
+    for name in table["cases"]:
+        for run in (1, 2):
+            doc = json.load(open(tmp_path / "results" / "smoke" / name / str(run) / "run.json"))
+            assert doc["mode"] == "threaded" and doc["end_state"] == "completed"
 
 
 def test_interrupted_job_leaves_no_result(tmp_path):
