@@ -228,6 +228,28 @@ TEST(CliRunOutputs, SavedFramesAreWrittenWhileTheRunGoesOn) {
   EXPECT_EQ(frame.cols, 320);
 }
 
+// OpenCV's imgcodecs and videoio (and the 200 libraries behind them) are loaded only when needed
+// (io/opencv_extras.h): a run on PNG / JPEG images, with saved frames and the report, needs none of them.
+TEST(CliRunOutputs, RunOnPngAndJpegImagesNeedsNoneOfOpenCvsCodecs) {
+  TempDir dir;
+  const auto seq = synth_small(dir, 40);  // the generator writes its PNGs through the module
+  const std::string missing = (dir / "no-such-module.so").string();
+  ASSERT_EQ(setenv("CROWDSLAM_OPENCV_EXTRAS", missing.c_str(), 1), 0);  // inherited by the runs below
+  const auto out = dir / "out";
+  const auto r = run_cli(run_args(seq, out, {"--save-frames", "10"}));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const cv::Mat frame = cv::imread((out / "frames" / "000030.jpg").string());
+  EXPECT_EQ(frame.cols, 320);
+  EXPECT_EQ(frame.rows, 240);
+  EXPECT_NE(read_text(out / "report.html").find("data:image/jpeg;base64,/9j/"), std::string::npos);
+  // A video does need the module: the error says which file could not be loaded.
+  write_text(dir / "clip.avi", std::string("RIFF\x10\0\0\0AVI LIST\0\0\0\0\xff\xfe", 22));
+  const auto video = run_cli({"run", "--dataset", (dir / "clip.avi").string(), "--out", (dir / "v").string()});
+  unsetenv("CROWDSLAM_OPENCV_EXTRAS");
+  EXPECT_NE(video.exit_code, 0);
+  EXPECT_NE(video.err.find(missing), std::string::npos) << video.err;
+}
+
 TEST(CliRunOutputs, DepthImagesWithoutAnyDepthAreWarnedAndCounted) {
   TempDir dir;
   const auto seq = synth_small(dir, 10);

@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "crowdslam/io/input_text.h"
 #include "crowdslam/io/jpeg_decode.h"
+#include "crowdslam/io/opencv_extras.h"
 #include "crowdslam/io/png_decode.h"
 #include "crowdslam/util/error.h"
 
@@ -93,7 +95,7 @@ cv::Mat decode(const std::string& path, int flags) {
   }
   cv::Mat image;
   try {
-    image = cv::imdecode(bytes, flags);
+    image = opencv_extras().imdecode(bytes, flags);
   } catch (const cv::Exception& e) {
     throw input_error(clip_text(path), std::string("cannot decode image: ") + e.what());
   }
@@ -105,6 +107,14 @@ cv::Mat decode(const std::string& path, int flags) {
 }  // namespace
 
 cv::Mat read_colour_image(const std::string& path) { return decode(path, cv::IMREAD_ANYCOLOR); }
+
+cv::Mat read_bgr_image(const std::string& path) {
+  cv::Mat image = decode(path, cv::IMREAD_ANYCOLOR);
+  if (image.channels() == 1) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
+  return image;
+}
+
+cv::Mat read_image_unchanged(const std::string& path) { return decode(path, cv::IMREAD_UNCHANGED); }
 
 cv::Mat read_depth_image(const std::string& path) {
   cv::Mat depth = decode(path, cv::IMREAD_UNCHANGED);

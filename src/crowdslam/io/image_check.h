@@ -13,7 +13,7 @@
 //     The common PNGs (8/16-bit grey, RGB, RGBA, not interlaced: depth maps, KITTI/TUM images) are then
 //     decoded by png_decode.h (libdeflate, about 3 times faster, same pixels; image data that does not
 //     inflate or inflates short is an error naming the file); the rest by cv::imdecode.
-//   - Other formats are only checked by decoding (cv::imdecode).
+//   - Other formats are only checked by decoding (cv::imdecode, through opencv_extras.h).
 // Files are read into memory once; decoding does not touch the disk again.
 #include <opencv2/core.hpp>
 #include <string>
@@ -25,6 +25,13 @@ namespace crowdslam::io {
 // cv::imread(path, cv::IMREAD_ANYCOLOR) for a valid file. Throws InputError naming `path` when it is
 // missing, not a regular file, empty, truncated, corrupt or undecodable.
 cv::Mat read_colour_image(const std::string& path);
+
+// As read_colour_image, with grey images made 3-channel: what cv::imread(path, cv::IMREAD_COLOR) gives.
+cv::Mat read_bgr_image(const std::string& path);
+
+// As stored, with alpha and 16-bit samples kept (JPEG: as read_colour_image): cv::imread(path,
+// cv::IMREAD_UNCHANGED).
+cv::Mat read_image_unchanged(const std::string& path);
 
 // Raw 16-bit single-channel depth (values as stored, metres = value / DepthMapFactor). Throws InputError
 // naming `path` for any other type (e.g. an 8-bit depth image) or when missing/truncated/undecodable.

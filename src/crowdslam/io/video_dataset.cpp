@@ -14,20 +14,17 @@ std::unique_ptr<VideoSource> VideoSource::open_file(const std::string& path, con
   if (!std::filesystem::is_regular_file(path, ec))
     throw input_error(clip_text(path), "video file does not exist");
   std::unique_ptr<VideoSource> source(new VideoSource(path, false));
+  source->capture_ = opencv_extras().video_capture();
   try {
-    // FFmpeg handles nearly every file; OpenCV's own MJPEG reader and image-sequence patterns
-    // ("img_%04d.png") as fallbacks. GStreamer is left out: it adds nothing for files here and its
-    // plugin scan leaks (libusb) under LeakSanitizer.
-    for (const int backend : {cv::CAP_FFMPEG, cv::CAP_OPENCV_MJPEG, cv::CAP_IMAGES})
-      if (source->capture_.open(path, backend)) break;
+    source->capture_->open_file(path);  // FFmpeg, OpenCV's MJPEG reader, image-sequence patterns
   } catch (const cv::Exception& e) {
     throw input_error(path, std::string("cannot open video: ") + e.what());
   }
-  if (!source->capture_.isOpened())
+  if (!source->capture_->is_opened())
     throw input_error(path, "cannot open as a video (unknown format or corrupt file)");
-  const double file_fps = source->capture_.get(cv::CAP_PROP_FPS);
+  const double file_fps = source->capture_->fps();
   source->fps_ = options.fps > 0 ? options.fps : (std::isfinite(file_fps) && file_fps > 0 ? file_fps : 30.0);
-  const double count = source->capture_.get(cv::CAP_PROP_FRAME_COUNT);
+  const double count = source->capture_->frame_count();
   source->frame_count_ = std::isfinite(count) && count > 0 ? static_cast<std::size_t>(count) : 0;
   source->opened_at_ = std::chrono::steady_clock::now();
   return source;
@@ -37,13 +34,14 @@ std::unique_ptr<VideoSource> VideoSource::open_camera(int index, const DatasetOp
   options.check();
   const std::string name = "camera " + std::to_string(index);
   std::unique_ptr<VideoSource> source(new VideoSource(name, true));
+  source->capture_ = opencv_extras().video_capture();
   try {
-    source->capture_.open(index);
+    source->capture_->open_camera(index);
   } catch (const cv::Exception& e) {
     throw input_error(name, std::string("cannot open: ") + e.what());
   }
-  if (!source->capture_.isOpened()) throw input_error(name, "cannot open camera");
-  const double camera_fps = source->capture_.get(cv::CAP_PROP_FPS);
+  if (!source->capture_->is_opened()) throw input_error(name, "cannot open camera");
+  const double camera_fps = source->capture_->fps();
   source->fps_ =
       options.fps > 0 ? options.fps : (std::isfinite(camera_fps) && camera_fps > 0 ? camera_fps : 30.0);
   source->opened_at_ = std::chrono::steady_clock::now();
@@ -54,7 +52,7 @@ std::optional<Frame> VideoSource::next() {
   Frame frame;
   bool ok = false;
   try {
-    ok = capture_.read(frame.images.colour);
+    ok = capture_->read(frame.images.colour);
   } catch (const cv::Exception& e) {
     throw input_error(path_, "frame " + std::to_string(next_index_) + ": cannot decode: " + e.what());
   }

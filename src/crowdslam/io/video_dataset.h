@@ -1,13 +1,14 @@
 #pragma once
-// Sequential-only sources through cv::VideoCapture: a video file or a live camera (index).
+// Sequential-only sources through cv::VideoCapture (in the module of opencv_extras.h, loaded when a video
+// or camera is opened): a video file or a live camera (index).
 // Video frames get timestamps index / fps (DatasetOptions::fps, else the file's rate, else 30); camera
 // frames get the seconds elapsed since the camera was opened (steady clock). No ground truth.
 #include <chrono>
 #include <memory>
-#include <opencv2/videoio.hpp>
 #include <string>
 
 #include "crowdslam/io/dataset.h"
+#include "crowdslam/io/opencv_extras.h"
 
 namespace crowdslam::io {
 
@@ -30,7 +31,7 @@ class VideoSource : public FrameSource {
 
   std::string path_;
   bool is_camera_ = false;
-  cv::VideoCapture capture_;
+  std::unique_ptr<VideoCaptureHandle> capture_;
   double fps_ = 30.0;
   std::size_t frame_count_ = 0;  // from the container; 0 = unknown
   std::size_t next_index_ = 0;

@@ -5,9 +5,9 @@
 
 #include <cerrno>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
 #include <vector>
 
+#include "crowdslam/io/jpeg_encode.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
@@ -185,11 +185,7 @@ void JournalWriter::write_frame(size_t index, const std::function<cv::Mat()>& dr
   const auto path = options_.frames_dir / name;
   try {
     const cv::Mat image = draw();
-    std::vector<uchar> jpeg;
-    if (!cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality})) {
-      fail(path.string(), "cannot encode JPEG");
-      return;
-    }
+    const std::vector<unsigned char> jpeg = io::encode_jpeg(image, options_.jpeg_quality);
     AtomicFile file(path);
     file.stream().write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
     file.commit();

@@ -1,6 +1,8 @@
 #pragma once
 // A fixed grid over the (undistorted) image that buckets keypoint indices, for fast "features within r
-// pixels of (x, y)" queries in the matcher's searches.
+// pixels of (x, y)" queries in the matcher's searches. The buckets are one array sorted by cell (row-major,
+// then keypoint index) with each entry's position and octave beside its index, so a query reads one
+// contiguous run per grid row and never the keypoints themselves.
 #include <opencv2/core/types.hpp>
 #include <vector>
 
@@ -20,7 +22,8 @@ class FeatureGrid {
 
   // Indices of keypoints within the square of half-side `radius` around (x, y) (and inside the circle's
   // bounding square, as the searches expect), optionally restricted to octaves [min_level, max_level]
-  // (-1 = no limit).
+  // (-1 = no limit); by cell (row-major), then by index. `keys_un` must be the keypoints the grid was
+  // built from (their positions and octaves are kept in the grid).
   [[nodiscard]] std::vector<size_t> features_in_area(const std::vector<cv::KeyPoint>& keys_un, float x, float y,
                                                      float radius, int min_level = -1, int max_level = -1) const;
   [[nodiscard]] const ImageBounds& bounds() const { return bounds_; }
@@ -32,7 +35,13 @@ class FeatureGrid {
   float min_y_ = 0;
   float inv_cell_width_ = 0;
   float inv_cell_height_ = 0;
-  std::vector<std::vector<size_t>> cells_;  // row-major kRows x kCols
+  struct Entry {
+    float x, y;
+    int octave;
+    unsigned index;
+  };
+  std::vector<Entry> entries_;        // sorted by cell, then index
+  std::vector<unsigned> cell_start_;  // kRows x kCols + 1 offsets into entries_ (empty: no grid)
 };
 
 }  // namespace crowdslam::map

@@ -1,8 +1,10 @@
 // count_points_on_masks (map_export.h): map points observed on moving pixels.
 #include <cstdio>
-#include <opencv2/imgcodecs.hpp>
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
 #include <set>
 
+#include "crowdslam/io/image_check.h"
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map.h"
 #include "crowdslam/map/map_point.h"
@@ -24,8 +26,9 @@ MaskCount count_points_on_masks(const std::filesystem::path& map_file, const std
   for (const auto& kf : map.keyframes()) {
     char name[32];
     std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(kf->frame_id));
-    const cv::Mat mask = cv::imread((mask_dir / name).string(), cv::IMREAD_GRAYSCALE);
-    if (mask.empty()) continue;
+    if (!std::filesystem::is_regular_file(mask_dir / name)) continue;
+    cv::Mat mask = io::read_colour_image((mask_dir / name).string());
+    if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_BGR2GRAY);
     ++count.keyframes_with_mask;
     for (const auto& point : kf->valid_map_points()) {
       seen.insert(point->id);

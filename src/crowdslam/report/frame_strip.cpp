@@ -2,9 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "crowdslam/io/image_check.h"
+#include "crowdslam/io/jpeg_encode.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
 
@@ -64,9 +65,12 @@ std::vector<EmbeddedFrame> embed_frames(const std::vector<std::filesystem::path>
   std::vector<EmbeddedFrame> frames;
   for (const size_t i : spread_indices(files.size(), options.max_frames)) {
     const auto& file = files[i];
-    cv::Mat image = cv::imread(file.string(), cv::IMREAD_COLOR);
-    if (image.empty()) {
-      spdlog::warn("report: {}: not a readable image, left out of the strip", clip_text(file.string()));
+    cv::Mat image;
+    try {
+      image = io::read_bgr_image(file.string());
+    } catch (const std::exception& e) {
+      spdlog::warn("report: {}: not a readable image, left out of the strip ({})", clip_text(file.string()),
+                   e.what());
       continue;
     }
     if (image.cols > options.width_px) {
@@ -75,8 +79,7 @@ std::vector<EmbeddedFrame> embed_frames(const std::vector<std::filesystem::path>
       cv::resize(image, small, cv::Size(options.width_px, height), 0, 0, cv::INTER_AREA);
       image = small;
     }
-    std::vector<unsigned char> jpeg;
-    cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+    const std::vector<unsigned char> jpeg = io::encode_jpeg(image, options.jpeg_quality);
     EmbeddedFrame frame;
     frame.frame_index = parse_int(file.stem().string()).value_or(-1);
     frame.data_url = "data:image/jpeg;base64," + base64_encode(jpeg.data(), jpeg.size());

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "crowdslam/io/opencv_extras.h"
 #include "crowdslam/synth/sprites.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/project_paths.h"
@@ -156,7 +157,7 @@ std::vector<Sprite> load_sprites(const fs::path& dir) {
       throw input_error(list_name, "sprite entry: bad file name '" + clip_text(sprite.record.file) + "'");
     }
     const fs::path path = dir / sprite.record.file;
-    const cv::Mat bgra = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat bgra = io::opencv_extras().imread(path.string(), cv::IMREAD_UNCHANGED);
     if (bgra.empty()) throw input_error(path.string(), "cannot read sprite");
     if (bgra.type() != CV_8UC4)
       throw input_error(path.string(), "sprite must be a 4-channel (BGRA) 8-bit PNG");

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "crowdslam/io/opencv_extras.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
@@ -80,7 +81,7 @@ fs::path frame_image(const fs::path& sequence, int frame) {
 }
 
 cv::Mat read_image(const fs::path& path) {
-  cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+  cv::Mat image = io::opencv_extras().imread(path.string(), cv::IMREAD_COLOR);
   if (image.empty()) throw input_error(path.string(), "cannot read image");
   return image;
 }
@@ -143,7 +144,7 @@ struct Person {
 void write_png(const fs::path& path, const cv::Mat& image) {
   bool ok = false;
   try {
-    ok = cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 6});
+    ok = io::opencv_extras().imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 6});
   } catch (const cv::Exception& e) {
     throw input_error(path.string(), std::string("cannot write image: ") + e.what());
   }

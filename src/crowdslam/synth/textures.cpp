@@ -6,6 +6,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "crowdslam/io/opencv_extras.h"
+
 namespace crowdslam::synth {
 namespace {
 
@@ -157,7 +159,7 @@ std::vector<cv::Mat> load_photos(const std::string& dir) {
     const std::filesystem::path path = std::filesystem::path(dir) / name;
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) continue;
-    cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+    cv::Mat image = io::opencv_extras().imread(path.string(), cv::IMREAD_COLOR);
     if (image.empty() || image.cols < 64 || image.rows < 64) continue;
     photos.push_back(image);
   }

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "crowdslam/io/opencv_extras.h"
 #include "crowdslam/io/trajectory.h"
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/interrupt.h"
@@ -41,7 +42,8 @@ void write_png(const fs::path& path, const cv::Mat& image) {
   bool ok = false;
   const int strategy = image.channels() == 3 ? cv::IMWRITE_PNG_STRATEGY_RLE : cv::IMWRITE_PNG_STRATEGY_DEFAULT;
   try {
-    ok = cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY, strategy});
+    ok = io::opencv_extras().imwrite(path.string(), image,
+                                     {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY, strategy});
   } catch (const cv::Exception& e) {
     throw input_error(path.string(), std::string("cannot write image: ") + e.what());
   }

@@ -1,11 +1,12 @@
 #include "crowdslam/viewer/messages.h"
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
+
+#include "crowdslam/io/jpeg_encode.h"
 
 namespace crowdslam::viewer {
 
@@ -74,8 +75,7 @@ std::string image_json(size_t index, const cv::Mat& image, const std::vector<peo
   } else {
     small = image;
   }
-  std::vector<uint8_t> jpeg;
-  cv::imencode(".jpg", small, jpeg, {cv::IMWRITE_JPEG_QUALITY, 70});
+  const std::vector<uint8_t> jpeg = io::encode_jpeg(small, 70);
   nlohmann::json j = {{"index", index}, {"width", small.cols}, {"height", small.rows}};
   j["jpeg"] = base64(jpeg);
   nlohmann::json b = nlohmann::json::array();
