@@ -25,8 +25,8 @@ import re
 import subprocess
 import sys
 
-# (key, label, parent, patterns): a pattern matches the start of a demangled function name (without its
-# argument list). A function counts once per stage even when several patterns match.
+# (key, label, parent, functions): each pattern names one function (its demangled name without the argument
+# list); a stage's cost is the sum of its functions' inclusive costs, so they must not call one another.
 STAGES = [
     ("decode", "decoding (colour JPEG, depth PNG)", None,
      [r"crowdslam::io::decode_jpeg$", r"crowdslam::io::decode_png$"]),
@@ -46,7 +46,9 @@ STAGES = [
     ("people", "people stage (boxes, flat-box test, filter, budget)", None,
      [r"crowdslam::people::PeopleStage::filter$", r"crowdslam::people::PeopleStage::begin_frame$"]),
     ("tracking", "tracking (Tracker::track)", None, [r"crowdslam::tracking::Tracker::track$"]),
-    ("dynamic", "geometric dynamic check", "tracking", [r"crowdslam::tracking::DynamicCheck::"]),
+    ("dynamic", "geometric dynamic check", "tracking",
+     [r"crowdslam::tracking::DynamicCheck::" + f + "$" for f in
+      ("inherit", "screen", "update", "free_space", "trusted_inliers")]),
     ("local_map", "local map search and pose", "tracking", [r"crowdslam::tracking::Tracker::track_local_map$"]),
     ("mapping", "local mapping (LocalMapper::process_keyframe)", None,
      [r"crowdslam::mapping::LocalMapper::process_keyframe$"]),
@@ -59,10 +61,9 @@ STAGES = [
     ("loop", "loop closing (detection, Sim3, correction)", None, [r"crowdslam::loop::LoopCloser::process_keyframe$"]),
     ("loop_detect", "loop detection", "loop", [r"crowdslam::loop::LoopDetector::detect$"]),
     ("journal", "journal (trajectory records, saved frames)", None,
-     [r"crowdslam::journal::JournalWriter::", r"crowdslam::journal::RunJournal::"]),
+     [r"crowdslam::journal::RunJournal::on_frame$", r"crowdslam::journal::JournalWriter::run$"]),
 ]
 
-BIN = "build/apps/crowdslam/crowdslam"
 LINE = re.compile(r"^\s*([\d,]+)\s+\(\s*[\d.]+%\)\s+[^\s:]+:(.+?)(?:\s+\[[^\]]*\])?\s*$")
 TOTAL = re.compile(r"^\s*([\d,]+)\s+\(100\.0%\)\s+PROGRAM TOTALS")
 
@@ -100,18 +101,9 @@ def read_inclusive(path):
 
 
 def stage_costs(costs):
-    """Inclusive cost per stage: the largest matching function (callers include their callees, so the
-    outermost match is the stage's cost; the sum would count nested matches twice)."""
-    result = {}
-    for key, _label, _parent, patterns in STAGES:
-        regs = [re.compile(p) for p in patterns]
-        matches = [(cost, name) for name, cost in costs.items() if any(r.search(name) for r in regs)]
-        if len(patterns) > 1 and key in ("decode", "people", "assemble", "journal"):
-            # Alternatives that do not call each other: their costs add up.
-            result[key] = sum(c for c, _ in matches)
-        else:
-            result[key] = max((c for c, _ in matches), default=0)
-    return result
+    """Inclusive cost per stage: the sum over its functions (each the function the pattern names)."""
+    return {key: sum(cost for name, cost in costs.items() if any(re.fullmatch(p, name) for p in patterns))
+            for key, _label, _parent, patterns in STAGES}
 
 
 def account(path, frames):
@@ -160,10 +152,10 @@ namespace hwy { namespace platform { uint64_t TimerResolution() { return 1; } } 
 """
 
 
-def valgrind_env(out):
+def valgrind_env(binary, out):
     """The environment for valgrind: LD_PRELOAD of a stub for libhwy's timer when the binary loads libhwy."""
     env = dict(os.environ)
-    ldd = subprocess.run(["ldd", BIN], capture_output=True, text=True).stdout
+    ldd = subprocess.run(["ldd", binary], capture_output=True, text=True).stdout
     if "libhwy" not in ldd:
         return env
     source, script = os.path.join(out, "hwystub.cpp"), os.path.join(out, "hwystub.map")
@@ -202,14 +194,12 @@ def main():
             parser.error("give RUN_ARGS after --, e.g. -- --dataset ../shared/data/bonn_crowd --settings config/Bonn.yaml")
         out = args.out
         os.makedirs(out, exist_ok=True)
-        global BIN
-        BIN = args.bin
         profile = os.path.join(out, "callgrind.out")
         run_dir = os.path.join(out, "run")
         command = ["valgrind", "--tool=callgrind", "--callgrind-out-file=" + profile,
                    args.bin, "run", "--sequential", "--overwrite", "--out", run_dir] + run_args
         print("profile_stages:", " ".join(command), file=sys.stderr, flush=True)
-        subprocess.run(command, check=True, env=valgrind_env(out))
+        subprocess.run(command, check=True, env=valgrind_env(args.bin, out))
     acc = account(profile, frames_of(os.path.join(out, "run")))
     with open(os.path.join(out, "stages.json"), "w") as f:
         json.dump(acc, f, indent=1)
