@@ -114,8 +114,6 @@ cv::Mat read_bgr_image(const std::string& path) {
   return image;
 }
 
-cv::Mat read_image_unchanged(const std::string& path) { return decode(path, cv::IMREAD_UNCHANGED); }
-
 cv::Mat read_depth_image(const std::string& path) {
   cv::Mat depth = decode(path, cv::IMREAD_UNCHANGED);
   if (depth.type() != CV_16UC1) {

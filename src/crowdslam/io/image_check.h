@@ -29,10 +29,6 @@ cv::Mat read_colour_image(const std::string& path);
 // As read_colour_image, with grey images made 3-channel: what cv::imread(path, cv::IMREAD_COLOR) gives.
 cv::Mat read_bgr_image(const std::string& path);
 
-// As stored, with alpha and 16-bit samples kept (JPEG: as read_colour_image): cv::imread(path,
-// cv::IMREAD_UNCHANGED).
-cv::Mat read_image_unchanged(const std::string& path);
-
 // Raw 16-bit single-channel depth (values as stored, metres = value / DepthMapFactor). Throws InputError
 // naming `path` for any other type (e.g. an 8-bit depth image) or when missing/truncated/undecodable.
 cv::Mat read_depth_image(const std::string& path);

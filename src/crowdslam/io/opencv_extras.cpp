@@ -2,16 +2,12 @@
 
 #include <dlfcn.h>
 
-#include <atomic>
 #include <cstdlib>
 #include <filesystem>
-#include <mutex>
 #include <stdexcept>
 
 namespace crowdslam::io {
 namespace {
-
-std::atomic<bool> loaded{false};
 
 constexpr const char* kModuleName = "libcrowdslam_opencv_extras.so";
 
@@ -21,7 +17,7 @@ std::string module_path() {
   const char* env = std::getenv("CROWDSLAM_OPENCV_EXTRAS");
   if (env != nullptr && *env != '\0') return env;
   Dl_info info{};
-  if (dladdr(reinterpret_cast<void*>(&opencv_extras_loaded), &info) != 0 && info.dli_fname != nullptr) {
+  if (dladdr(reinterpret_cast<void*>(&opencv_extras), &info) != 0 && info.dli_fname != nullptr) {
     std::error_code ec;
     const auto beside = std::filesystem::path(info.dli_fname).parent_path() / kModuleName;
     if (std::filesystem::is_regular_file(beside, ec)) return beside.string();
@@ -41,7 +37,6 @@ const OpenCvExtras* load() {
   using Entry = const OpenCvExtras* (*)();
   auto entry = reinterpret_cast<Entry>(dlsym(handle, "crowdslam_opencv_extras"));
   if (entry == nullptr) throw std::runtime_error(path + " has no crowdslam_opencv_extras entry point");
-  loaded = true;
   return entry();  // never unloaded: OpenCV's libraries keep threads and static state
 }
 
@@ -51,7 +46,5 @@ const OpenCvExtras& opencv_extras() {
   static const OpenCvExtras* extras = load();  // a failed load throws and is retried by the next call
   return *extras;
 }
-
-bool opencv_extras_loaded() { return loaded; }
 
 }  // namespace crowdslam::io

@@ -47,7 +47,4 @@ class OpenCvExtras {
 // the module's path and the loader's message when it cannot be loaded.
 const OpenCvExtras& opencv_extras();
 
-// Whether this process has loaded the module (for tests and statistics).
-bool opencv_extras_loaded();
-
 }  // namespace crowdslam::io
