@@ -166,6 +166,31 @@ TEST(PngDecode, ValidDepthEqualsImreadAndTrailingBytesAreAccepted) {
   EXPECT_EQ(max_difference(read_depth_image((dir / "padded.png").string()), reference), 0.0);
 }
 
+TEST(MaskImage, SixteenBitIdsAndColourMasksAreSetWhereverNonZero) {
+  test::TempDir dir;
+  // A 16-bit id image as synth's people_mask/ writes it: ids 1 and 300 (both below 256 after an 8-bit
+  // reduction, which turned the whole mask to 0).
+  cv::Mat ids = cv::Mat::zeros(20, 30, CV_16UC1);
+  ids(cv::Rect(2, 3, 4, 5)).setTo(1);
+  ids(cv::Rect(20, 10, 6, 2)).setTo(300);
+  ASSERT_TRUE(cv::imwrite((dir / "ids.png").string(), ids));
+  const cv::Mat mask = read_mask_image((dir / "ids.png").string());
+  ASSERT_EQ(mask.type(), CV_8UC1);
+  EXPECT_EQ(cv::countNonZero(mask), 4 * 5 + 6 * 2);
+  EXPECT_EQ(mask.at<uint8_t>(3, 2), 255);
+  EXPECT_EQ(mask.at<uint8_t>(10, 25), 255);
+  EXPECT_EQ(mask.at<uint8_t>(0, 0), 0);
+  // A colour mask set in one channel only.
+  cv::Mat colour = cv::Mat::zeros(20, 30, CV_8UC3);
+  colour.at<cv::Vec3b>(7, 8) = cv::Vec3b(0, 0, 9);
+  ASSERT_TRUE(cv::imwrite((dir / "colour.png").string(), colour));
+  const cv::Mat from_colour = read_mask_image((dir / "colour.png").string());
+  EXPECT_EQ(cv::countNonZero(from_colour), 1);
+  EXPECT_EQ(from_colour.at<uint8_t>(7, 8), 255);
+  const std::string message = error_of([&] { (void)read_mask_image((dir / "missing.png").string()); });
+  EXPECT_NE(message.find("missing.png"), std::string::npos) << message;
+}
+
 TEST(PngDecodeErrors, FlippedBitIsACrcErrorNamingTheFileWithoutLibpngNoise) {
   test::TempDir dir;
   const fs::path path = noise_png(dir);

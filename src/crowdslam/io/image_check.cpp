@@ -114,6 +114,15 @@ cv::Mat read_bgr_image(const std::string& path) {
   return image;
 }
 
+cv::Mat read_mask_image(const std::string& path) {
+  const cv::Mat image = decode(path, cv::IMREAD_UNCHANGED);
+  std::vector<cv::Mat> channels;
+  cv::split(image, channels);
+  cv::Mat mask = cv::Mat::zeros(image.size(), CV_8UC1);
+  for (const cv::Mat& channel : channels) mask.setTo(255, channel != 0);
+  return mask;
+}
+
 cv::Mat read_depth_image(const std::string& path) {
   cv::Mat depth = decode(path, cv::IMREAD_UNCHANGED);
   if (depth.type() != CV_16UC1) {

@@ -29,6 +29,11 @@ cv::Mat read_colour_image(const std::string& path);
 // As read_colour_image, with grey images made 3-channel: what cv::imread(path, cv::IMREAD_COLOR) gives.
 cv::Mat read_bgr_image(const std::string& path);
 
+// A mask: 255 where the stored image is non-zero in any channel, else 0 (8-bit single-channel). Reads 8-
+// and 16-bit images as stored, so a 16-bit id image (synth's people_mask/) is not reduced to 8 bits
+// first. Throws InputError naming `path` as read_colour_image does.
+cv::Mat read_mask_image(const std::string& path);
+
 // Raw 16-bit single-channel depth (values as stored, metres = value / DepthMapFactor). Throws InputError
 // naming `path` for any other type (e.g. an 8-bit depth image) or when missing/truncated/undecodable.
 cv::Mat read_depth_image(const std::string& path);

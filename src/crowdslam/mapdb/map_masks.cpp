@@ -1,7 +1,6 @@
 // count_points_on_masks (map_export.h): map points observed on moving pixels.
 #include <cstdio>
 #include <filesystem>
-#include <opencv2/imgproc.hpp>
 #include <set>
 
 #include "crowdslam/io/image_check.h"
@@ -27,8 +26,7 @@ MaskCount count_points_on_masks(const std::filesystem::path& map_file, const std
     char name[32];
     std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(kf->frame_id));
     if (!std::filesystem::is_regular_file(mask_dir / name)) continue;
-    cv::Mat mask = io::read_colour_image((mask_dir / name).string());
-    if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_BGR2GRAY);
+    const cv::Mat mask = io::read_mask_image((mask_dir / name).string());
     ++count.keyframes_with_mask;
     for (const auto& point : kf->valid_map_points()) {
       seen.insert(point->id);
