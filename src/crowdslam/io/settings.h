@@ -134,6 +134,10 @@ struct TrackingSettings {
   // Monocular: lost in a grown map, a two-view map made where the camera is joins the same map, placed
   // and scaled by the motion before the loss, if it succeeds within reanchor_max_s (0 = off: a new map).
   double reanchor_max_s = 3.0;
+  // RGB-D / stereo: local bundle adjustment keeps each keyframe near the pose tracking measured for it
+  // relative to the keyframe before, with this rotation sigma in degrees (translation: the angle times
+  // the keyframe's median depth); 0 = off, as ORB-SLAM.
+  double odometry_sigma_deg = 0.3;
 };
 
 // A monocular camera that rides at a constant height above planar ground (on a car or a ground robot):

@@ -231,6 +231,9 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(s.tracking.reanchor_max_s) && s.tracking.reanchor_max_s >= 0 &&
                 s.tracking.reanchor_max_s <= 60,
             "Tracking.reanchor_max_s", "in [0, 60] seconds (0 = off)", s.tracking.reanchor_max_s);
+  c.require(std::isfinite(s.tracking.odometry_sigma_deg) && s.tracking.odometry_sigma_deg >= 0 &&
+                s.tracking.odometry_sigma_deg <= 90,
+            "Tracking.odometry_sigma_deg", "in [0, 90] degrees (0 = off)", s.tracking.odometry_sigma_deg);
   c.require(std::isfinite(s.tracking.bridge_min_people_share) && s.tracking.bridge_min_people_share >= 0 &&
                 s.tracking.bridge_min_people_share <= 1,
             "Tracking.bridge_min_people_share", "in [0, 1]", s.tracking.bridge_min_people_share);

@@ -83,6 +83,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Tracking.bridge_max_s",
                                   "Tracking.bridge_min_people_share",
                                   "Tracking.reanchor_max_s",
+                                  "Tracking.odometry_sigma_deg",
                                   "Ground.enabled",
                                   "Ground.keyframe_sigma",
                                   "FeatureBudget.enabled",

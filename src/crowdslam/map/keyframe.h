@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -33,6 +34,17 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const std::shared_ptr<const geometry::PinholeCamera> camera;
   const std::shared_ptr<const ScaleLevels> levels;
   const std::shared_ptr<const FrameFeatures> features;
+
+  // The pose tracking measured for this keyframe relative to an earlier keyframe (RGB-D and stereo: the
+  // keyframe before it, when every frame in between was tracked): local bundle adjustment keeps the two
+  // near it (LocalMapperOptions::odometry_sigma_deg). Set by tracking before the keyframe is handed to
+  // the mapper, read-only afterwards; not saved with a map.
+  struct Odometry {
+    uint64_t other_id = 0;
+    geometry::SE3 cam_from_other;
+    double median_depth = 0;  // of the keyframe's map points, for the translation's sigma
+  };
+  std::optional<Odometry> odometry;
 
   // Pose.
   [[nodiscard]] geometry::SE3 cam_from_world() const;

@@ -1,6 +1,7 @@
 // Local mapping step: local bundle adjustment over the new keyframe's covisibility neighbourhood.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -91,8 +92,24 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
   }
   if (abort_ba_) return;
 
+  // Tracked relative poses between keyframes of the adjustment (KeyFrame::odometry).
+  std::vector<optim::BaRelativePose> relative_poses;
+  if (options_.odometry_sigma_deg > 0) {
+    const double sigma_rad = options_.odometry_sigma_deg * M_PI / 180.0;
+    for (const auto& [id, kf] : all_keyframes) {
+      if (!kf->odometry || !all_keyframes.count(kf->odometry->other_id)) continue;
+      if (!local_ids.count(id) && !local_ids.count(kf->odometry->other_id)) continue;  // both fixed
+      optim::BaRelativePose edge;
+      edge.keyframe_id = static_cast<int>(id);
+      edge.other_id = static_cast<int>(kf->odometry->other_id);
+      edge.cam_from_other = kf->odometry->cam_from_other;
+      edge.rotation_sigma_rad = sigma_rad;
+      edge.translation_sigma = sigma_rad * kf->odometry->median_depth;
+      relative_poses.push_back(edge);
+    }
+  }
   const auto result = optim::local_bundle_adjustment(*keyframe->camera, ba_keyframes, ba_points, observations,
-                                                     options_.ba, &abort_ba_);
+                                                     options_.ba, &abort_ba_, {}, relative_poses);
   {
     std::lock_guard map_lock(map_->update_mutex());
     for (size_t index : result.outliers) {
@@ -112,6 +129,7 @@ void LocalMapper::run_local_bundle_adjustment(const std::shared_ptr<map::KeyFram
   const double elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard lock(stats_mutex_);
   ++stats_.ba_runs;
+  stats_.ba_relative_poses += static_cast<int>(relative_poses.size());
   if (result.aborted) ++stats_.ba_aborted;
   stats_.ba_time_ms_total += elapsed_ms;
 }

@@ -19,6 +19,7 @@ void LocalMapperOptions::check() const {
   if (!(redundancy_ratio > 0 && redundancy_ratio <= 1))
     throw InputError("local mapper: redundancy_ratio in (0, 1]");
   if (!(delay_ms >= 0)) throw InputError("local mapper: delay_ms must be >= 0");
+  if (!(odometry_sigma_deg >= 0)) throw InputError("local mapper: odometry_sigma_deg must be >= 0");
   ba.check();
 }
 

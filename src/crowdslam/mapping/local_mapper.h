@@ -38,6 +38,9 @@ struct LocalMapperOptions {
   // this many fixed keyframes (those that see most of the window's points). ORB-SLAM2 takes all of them;
   // after a loop merges two passes over a place that becomes hundreds (see docs/ARCHITECTURE.md).
   int max_local_ba_keyframes = 25;
+  // Local BA keeps a keyframe's tracked pose relative to the keyframe before it (KeyFrame::odometry) with
+  // this rotation sigma (degrees; translation: the angle times the keyframe's median depth); 0 = off.
+  double odometry_sigma_deg = 0;
   optim::BundleAdjustmentOptions ba;
   double delay_ms = 0;  // experiments and tests: sleep this long per keyframe (an artificially slow mapper)
   void check() const;
@@ -60,6 +63,8 @@ struct LocalMapperStats {
   int keyframes_culled = 0;
   int ba_runs = 0;
   int ba_aborted = 0;
+  // Tracked relative poses between keyframes (KeyFrame::odometry) held in local BAs, summed over runs.
+  int ba_relative_poses = 0;
   double ba_time_ms_total = 0;
   // Time per step over all keyframes (ms).
   double register_ms_total = 0;

@@ -67,10 +67,12 @@ struct BaState {
   std::vector<int> obs_point;
   std::vector<int> plane_keyframe;  // per plane constraint, as obs_keyframe / obs_point
   std::vector<int> plane_point;
+  std::vector<SchurRelativePose> relative;  // state indices; both fixed or an unknown id: left out
 };
 
 BaState make_state(const std::vector<BaKeyframe>& keyframes, const std::vector<BaPoint>& points,
-                   const std::vector<BaObservation>& observations, const std::vector<BaPlaneConstraint>& planes) {
+                   const std::vector<BaObservation>& observations, const std::vector<BaPlaneConstraint>& planes,
+                   const std::vector<BaRelativePose>& relative_poses) {
   BaState state;
   std::unordered_map<int, int> keyframe_index;
   std::unordered_map<int, int> point_index;
@@ -97,6 +99,20 @@ BaState make_state(const std::vector<BaKeyframe>& keyframes, const std::vector<B
   for (const BaObservation& obs : observations) resolve(obs.keyframe_id, obs.point_id, state.obs_keyframe, state.obs_point);
   for (const BaPlaneConstraint& plane : planes) {
     resolve(plane.keyframe_id, plane.point_id, state.plane_keyframe, state.plane_point);
+  }
+  for (const BaRelativePose& edge : relative_poses) {
+    const auto a = keyframe_index.find(edge.keyframe_id);
+    const auto b = keyframe_index.find(edge.other_id);
+    if (a == keyframe_index.end() || b == keyframe_index.end() || a->second == b->second) continue;
+    if (keyframes[a->second].fixed && keyframes[b->second].fixed) continue;
+    SchurRelativePose r;
+    r.pose_a = a->second;
+    r.pose_b = b->second;
+    r.a_from_b = edge.cam_from_other;
+    const double wt = 1.0 / (edge.translation_sigma * edge.translation_sigma);
+    const double wr = 1.0 / (edge.rotation_sigma_rad * edge.rotation_sigma_rad);
+    r.weight << wt, wt, wt, wr, wr, wr;
+    state.relative.push_back(r);
   }
   return state;
 }
@@ -195,8 +211,8 @@ class BaSolver {
       o.huber_delta = kPlaneHuberDelta;
       observations.push_back(o);
     }
-    const SchurLmSummary summary =
-        solve_schur_lm(camera_, poses, fixed, state_.points, observations, iterations, abort_flag);
+    const SchurLmSummary summary = solve_schur_lm(camera_, poses, fixed, state_.points, observations, iterations,
+                                                  abort_flag, state_.relative);
     for (std::size_t k = 0; k < poses.size(); ++k) {
       if (!fixed[k]) state_.poses[k] = to_pose_block(poses[k]);
     }
@@ -250,6 +266,16 @@ class BaSolver {
       problem.AddResidualBlock(new PlaneDistanceCost(planes_[i].normal_cam, planes_[i].distance, planes_[i].sigma),
                                &plane_loss, pose, state_.points[p].data());
     }
+    for (const SchurRelativePose& edge : state_.relative) {
+      for (const int k : {edge.pose_a, edge.pose_b}) {
+        if (pose_used[k]) continue;
+        problem.AddParameterBlock(state_.poses[k].data(), 7, &manifold_);
+        if (keyframes_[k].fixed) problem.SetParameterBlockConstant(state_.poses[k].data());
+        pose_used[k] = true;
+      }
+      problem.AddResidualBlock(new RelativePoseCost(edge.a_from_b, edge.weight), nullptr,
+                               state_.poses[edge.pose_a].data(), state_.poses[edge.pose_b].data());
+    }
     ceres::Solver::Summary summary;
     if (problem.NumResidualBlocks() == 0) return summary;
 
@@ -290,7 +316,8 @@ BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera,
                                                const std::vector<BaObservation>& observations,
                                                const BundleAdjustmentOptions& options,
                                                const std::atomic<bool>* abort_flag,
-                                               const std::vector<BaPlaneConstraint>& planes) {
+                                               const std::vector<BaPlaneConstraint>& planes,
+                                               const std::vector<BaRelativePose>& relative_poses) {
   BundleAdjustmentResult result;
   result.keyframes = keyframes;
   result.points = points;
@@ -298,7 +325,7 @@ BundleAdjustmentResult local_bundle_adjustment(const PinholeCamera& camera,
     result.aborted = true;
     return result;
   }
-  BaState state = make_state(keyframes, points, observations, planes);
+  BaState state = make_state(keyframes, points, observations, planes, relative_poses);
   BaSolver solver(camera, keyframes, observations, planes, options, state);
 
   std::vector<bool> active(observations.size());

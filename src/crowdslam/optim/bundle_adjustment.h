@@ -52,6 +52,19 @@ struct BaPlaneConstraint {
   double sigma = 1.0;     // map units
 };
 
+// A measured relative pose between two keyframes: keyframe_id's cam_from_world times other_id's
+// world_from_cam should be `cam_from_other`; residual relative_pose_error (se3_update.h) weighed by
+// 1 / sigma^2 (translation: map units; rotation: radians), no robust loss, never an outlier. Tracking
+// measures it when it makes a keyframe (LocalMapperOptions::odometry_sigma_deg). Skipped when either id
+// is unknown or both keyframes are fixed.
+struct BaRelativePose {
+  int keyframe_id = -1;
+  int other_id = -1;
+  geometry::SE3 cam_from_other;
+  double translation_sigma = 1.0;
+  double rotation_sigma_rad = 1.0;
+};
+
 enum class BaLinearSolver {
   kAuto,         // kOwnSchur up to kOwnSchurMaxFreePoses free poses (local windows), else Ceres kSparseSchur
   kSparseSchur,  // Ceres SPARSE_SCHUR; falls back to DENSE_SCHUR when no sparse backend is compiled in
@@ -92,7 +105,8 @@ BundleAdjustmentResult local_bundle_adjustment(const geometry::PinholeCamera& ca
                                                const std::vector<BaObservation>& observations,
                                                const BundleAdjustmentOptions& options = {},
                                                const std::atomic<bool>* abort_flag = nullptr,
-                                               const std::vector<BaPlaneConstraint>& planes = {});
+                                               const std::vector<BaPlaneConstraint>& planes = {},
+                                               const std::vector<BaRelativePose>& relative_poses = {});
 
 // Whether this Ceres build has a sparse linear algebra backend (SuiteSparse, CXSparse, Eigen...).
 bool ceres_has_sparse_backend();

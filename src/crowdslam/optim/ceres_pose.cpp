@@ -1,5 +1,6 @@
 #include "crowdslam/optim/ceres_pose.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "crowdslam/optim/se3_update.h"
@@ -130,6 +131,32 @@ bool PlaneDistanceCost::Evaluate(double const* const* parameters, double* residu
   if (jacobians != nullptr) {
     const Eigen::Matrix<double, 1, 3> d = inv_sigma_ * normal_.transpose();
     write_jacobians<1>(d, p_cam, q, jacobians);
+  }
+  return true;
+}
+
+RelativePoseCost::RelativePoseCost(const SE3& a_from_b, const Vec6& weight)
+    : a_from_b_(a_from_b), sqrt_weight_(weight.cwiseSqrt()) {}
+
+bool RelativePoseCost::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  PoseBlock a;
+  PoseBlock b;
+  std::copy(parameters[0], parameters[0] + 7, a.begin());
+  std::copy(parameters[1], parameters[1] + 7, b.begin());
+  Eigen::Matrix<double, 6, 6> j_b;
+  const Vec6 e = relative_pose_error(from_pose_block(a), from_pose_block(b), a_from_b_, &j_b);
+  Eigen::Map<Vec6> r(residuals);
+  r = sqrt_weight_.cwiseProduct(e);
+  using Jacobian = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    Eigen::Map<Jacobian> j(jacobians[0]);
+    j.setZero();
+    j.leftCols<6>().diagonal() = sqrt_weight_;
+  }
+  if (jacobians != nullptr && jacobians[1] != nullptr) {
+    Eigen::Map<Jacobian> j(jacobians[1]);
+    j.setZero();
+    j.leftCols<6>() = sqrt_weight_.asDiagonal() * j_b;
   }
   return true;
 }

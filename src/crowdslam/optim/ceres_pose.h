@@ -83,4 +83,16 @@ class PlaneDistanceCost final : public ceres::SizedCostFunction<1, 7, 3> {
   double inv_sigma_;
 };
 
+// Residual sqrt(weight) .* relative_pose_error(a, b, a_from_b) (se3_update.h): a measured relative pose
+// between two keyframes (BaRelativePose); blocks: pose a (7), pose b (7).
+class RelativePoseCost final : public ceres::SizedCostFunction<6, 7, 7> {
+ public:
+  RelativePoseCost(const geometry::SE3& a_from_b, const geometry::Vec6& weight);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  geometry::SE3 a_from_b_;
+  geometry::Vec6 sqrt_weight_;
+};
+
 }  // namespace crowdslam::optim

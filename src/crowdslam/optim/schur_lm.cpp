@@ -96,6 +96,20 @@ class Problem {
   const std::vector<SchurObservation>& observations_;
 };
 
+// A relative pose's residual and the Jacobian of it for pose b (pose a's is the identity).
+Vec6 relative_error(const std::vector<SE3>& poses, const SchurRelativePose& edge, Mat6* jacobian_b = nullptr) {
+  return relative_pose_error(poses[edge.pose_a], poses[edge.pose_b], edge.a_from_b, jacobian_b);
+}
+
+double relative_cost(const std::vector<SE3>& poses, const std::vector<SchurRelativePose>& edges) {
+  double total = 0.0;
+  for (const SchurRelativePose& edge : edges) {
+    const Vec6 e = relative_error(poses, edge);
+    total += e.cwiseProduct(edge.weight).dot(e);
+  }
+  return total;
+}
+
 std::vector<Mat3> rotations_of(const std::vector<SE3>& poses) {
   std::vector<Mat3> rotations;
   rotations.reserve(poses.size());
@@ -113,17 +127,25 @@ Eigen::Matrix<double, N, 1> clamped_diagonal(const Eigen::Matrix<double, N, N>& 
 SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector<SE3>& poses,
                               const std::vector<bool>& fixed, std::vector<Vec3>& points,
                               const std::vector<SchurObservation>& observations, int max_iterations,
-                              const std::atomic<bool>* abort_flag) {
+                              const std::atomic<bool>* abort_flag,
+                              const std::vector<SchurRelativePose>& relative_poses) {
   SchurLmSummary summary;
   const Problem problem(camera, observations);
   std::vector<Mat3> rotations = rotations_of(poses);
+  // Observations' cost plus the relative poses'.
+  auto total_cost = [&](const std::vector<SE3>& at, const std::vector<Mat3>& rotations_at,
+                        const std::vector<Vec3>& points_at, double& total) {
+    if (!problem.cost(at, rotations_at, points_at, total)) return false;
+    total += 0.5 * relative_cost(at, relative_poses);
+    return true;
+  };
   double cost = 0.0;
-  if (!problem.cost(poses, rotations, points, cost)) {
+  if (!total_cost(poses, rotations, points, cost)) {
     summary.valid = false;
     return summary;
   }
   summary.initial_cost = summary.final_cost = cost;
-  if (observations.empty()) return summary;
+  if (observations.empty() && relative_poses.empty()) return summary;
 
   const auto num_poses = static_cast<int>(poses.size());
   const auto num_points = static_cast<int>(points.size());
@@ -143,6 +165,13 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
       by_point[next[observations[i].point]++] = static_cast<int>(i);
   }
 
+  // Off-diagonal blocks of the relative poses between two free poses (upper triangle: row < column).
+  struct Coupling {
+    int row = 0;
+    int col = 0;
+    Mat6 block;
+  };
+  std::vector<Coupling> couplings;
   std::vector<Mat6> u(num_free);
   std::vector<Vec6> g_pose(num_free);
   std::vector<Mat3> v(points.size());
@@ -196,6 +225,28 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
         g_pose[f].noalias() += j_pose_tw * r;
         w[i].noalias() = j_pose_tw * j_point;
       }
+      couplings.clear();
+      for (const SchurRelativePose& edge : relative_poses) {
+        Mat6 j_b;
+        const Vec6 e = relative_error(poses, edge, &j_b);
+        const Vec6 we = edge.weight.cwiseProduct(e);
+        const int fa = free_index[edge.pose_a];
+        const int fb = free_index[edge.pose_b];
+        const Mat6 wj_b = edge.weight.asDiagonal() * j_b;
+        if (fa >= 0) {
+          u[fa].diagonal() += edge.weight;
+          g_pose[fa] += we;
+        }
+        if (fb >= 0) {
+          u[fb].noalias() += j_b.transpose() * wj_b;
+          g_pose[fb].noalias() += j_b.transpose() * we;
+        }
+        if (fa >= 0 && fb >= 0) {
+          // J_a^T W J_b with J_a = I.
+          if (fa < fb) couplings.push_back({fa, fb, wj_b});
+          else couplings.push_back({fb, fa, wj_b.transpose()});
+        }
+      }
       linearize = false;
     }
 
@@ -207,6 +258,7 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
       s.block<6, 6>(6 * f, 6 * f) = block;
       rhs.segment<6>(6 * f) = -g_pose[f];
     }
+    for (const Coupling& c : couplings) s.block<6, 6>(6 * c.row, 6 * c.col) += c.block;
     for (int p = 0; p < num_points; ++p) {
       const int begin = point_start[p];
       const int end = point_start[p + 1];
@@ -281,7 +333,7 @@ SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector
     for (int p = 0; p < num_points; ++p) trial_points[p] += d_point[p];
     std::vector<Mat3> trial_rotations = rotations_of(trial_poses);
     double trial_cost = 0.0;
-    const bool valid = problem.cost(trial_poses, trial_rotations, trial_points, trial_cost);
+    const bool valid = total_cost(trial_poses, trial_rotations, trial_points, trial_cost);
     const double ratio = valid && model_decrease > 0.0 ? (cost - trial_cost) / model_decrease : -1.0;
     if (ratio > kMinRelativeDecrease) {
       const bool converged = std::abs(cost - trial_cost) <= kFunctionTolerance * cost;

@@ -42,6 +42,16 @@ struct SchurObservation {
   double distance = 0.0;
 };
 
+// A measured relative pose between two poses: residual e = (translation, so3 log of the rotation) of
+// poses[a] * poses[b]^-1 * a_from_b^-1, cost 1/2 e^T diag(weight) e (never robust). Jacobians: I for pose
+// a and -Ad(poses[a] * poses[b]^-1) for pose b, in the update's (rho, phi) coordinates, exact at e = 0.
+struct SchurRelativePose {
+  int pose_a = -1;
+  int pose_b = -1;
+  geometry::SE3 a_from_b;
+  geometry::Vec6 weight = geometry::Vec6::Zero();  // 1 / sigma^2: translation x3, rotation x3
+};
+
 struct SchurLmSummary {
   double initial_cost = 0.0;
   double final_cost = 0.0;
@@ -56,6 +66,7 @@ struct SchurLmSummary {
 SchurLmSummary solve_schur_lm(const geometry::PinholeCamera& camera, std::vector<geometry::SE3>& poses,
                               const std::vector<bool>& fixed, std::vector<geometry::Vec3>& points,
                               const std::vector<SchurObservation>& observations, int max_iterations,
-                              const std::atomic<bool>* abort_flag = nullptr);
+                              const std::atomic<bool>* abort_flag = nullptr,
+                              const std::vector<SchurRelativePose>& relative_poses = {});
 
 }  // namespace crowdslam::optim

@@ -50,4 +50,25 @@ inline Eigen::RowVector3d right_u_jacobian(double fx, double bf, const geometry:
   return {fx * inv_z, 0.0, -fx * p_cam.x() * inv_z2 + bf * inv_z2};
 }
 
+// Error of a measured relative pose a_from_b between cam_from_world poses a and b: the translation and
+// so3 log of a * b^-1 * a_from_b^-1. Under left updates of a and b its Jacobians are I (pose a) and
+// -Ad(a * b^-1) = -[[R, [t]x R], [0, R]] (pose b), (rho, phi) order, exact at zero error.
+inline geometry::Vec6 relative_pose_error(const geometry::SE3& a, const geometry::SE3& b,
+                                          const geometry::SE3& a_from_b,
+                                          Eigen::Matrix<double, 6, 6>* jacobian_b = nullptr) {
+  const geometry::SE3 measured_b = a * b.inverse();
+  const geometry::SE3 error = measured_b * a_from_b.inverse();
+  geometry::Vec6 e;
+  e.head<3>() = error.translation();
+  e.tail<3>() = geometry::so3_log(error.rotation_matrix());
+  if (jacobian_b != nullptr) {
+    const geometry::Mat3 rotation = measured_b.rotation_matrix();
+    jacobian_b->setZero();
+    jacobian_b->topLeftCorner<3, 3>() = -rotation;
+    jacobian_b->topRightCorner<3, 3>() = -geometry::skew(measured_b.translation()) * rotation;
+    jacobian_b->bottomRightCorner<3, 3>() = -rotation;
+  }
+  return e;
+}
+
 }  // namespace crowdslam::optim

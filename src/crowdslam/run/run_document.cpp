@@ -358,6 +358,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                           {"keyframes_culled", mapper.keyframes_culled},
                           {"ba_runs", mapper.ba_runs},
                           {"ba_aborted", mapper.ba_aborted},
+                          {"ba_relative_poses", mapper.ba_relative_poses},
                           {"ba_ms_mean", mapper.ba_runs > 0 ? mapper.ba_time_ms_total / mapper.ba_runs : 0.0},
                           {"register_ms_mean", mapper.register_ms_total / processed},
                           {"triangulation_ms_mean", mapper.triangulation_ms_total / processed},

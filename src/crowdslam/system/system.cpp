@@ -68,6 +68,11 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   mapper_options.monocular = options.sensor == io::SensorKind::kMonocular;
   mapper_options.close_depth_m = close_depth_m;
   mapper_options.delay_ms = options.mapper_delay_ms;
+  // Part of keeping people out, as the feature budget: the static-world baseline (--no-people-filter) runs
+  // without it, as ORB-SLAM. There tracking follows whatever moves, and its relative poses would only pass
+  // that on (docs/CROWDS.md#keyframes-that-see-a-strip-of-background).
+  mapper_options.odometry_sigma_deg =
+      options.people_filter && settings.people_filter.enabled ? settings.tracking.odometry_sigma_deg : 0.0;
   mapper_ = std::make_unique<mapping::LocalMapper>(mapper_options, map_);
 
   tracking::TrackerOptions tracker_options;

@@ -250,6 +250,9 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       result.method = "bridged";
     }
     state_ = ok ? TrackingState::kOk : occluded ? TrackingState::kBridged : TrackingState::kLost;
+    if (!ok || bridged || after_bridge || (result.method != "motion" && result.method != "reference")) {
+      odometry_chain_ = false;
+    }
     if (!ok) result.method = occluded ? "bridged" : "lost";
 
     if (ok && dynamic_check_.enabled()) {
@@ -402,6 +405,7 @@ bool Tracker::initialize(map::Frame& frame) {
   mapper_->insert_keyframe(keyframe);
   last_keyframe_ = keyframe;
   last_keyframe_frame_id_ = frame.id;
+  odometry_chain_ = true;
   reference_keyframe_ = keyframe;
   frame.reference_keyframe = keyframe;
   local_keyframes_ = {keyframe};

@@ -300,6 +300,9 @@ class Tracker {
   std::shared_ptr<map::KeyFrame> reference_keyframe_;
   std::shared_ptr<map::KeyFrame> last_keyframe_;
   uint64_t last_keyframe_frame_id_ = 0;
+  // Every frame since the last keyframe was tracked by the motion model or the reference keyframe (no
+  // relocalisation, bridge or odometry bridge): the next keyframe's KeyFrame::odometry can be measured.
+  bool odometry_chain_ = false;
   // Per keypoint of the frame that made last_keyframe_: its index in the keyframe (-1 = left out); empty
   // when the keyframe has the frame's keypoints as they are.
   std::vector<long> last_keyframe_indices_;

@@ -117,6 +117,22 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
   }
   // make_point_from_depth already linked the new points; registered observations for the rest come
   // from the mapper (process_new_keyframe).
+  // With depth, the pose relative to the keyframe before, when every frame since was tracked: tracking
+  // placed it with the last frame's depth points too, which never reach the map (KeyFrame::odometry).
+  if (!options_.monocular && odometry_chain_ && last_keyframe_ && !last_keyframe_->is_bad()) {
+    std::vector<double> depths;
+    const geometry::SE3 pose = *frame.cam_from_world;
+    for (const auto& point : keyframe->valid_map_points()) {
+      const double z = (pose * point->world()).z();
+      if (z > 0) depths.push_back(z);
+    }
+    if (!depths.empty()) {
+      const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
+      std::nth_element(depths.begin(), middle, depths.end());
+      keyframe->odometry = map::KeyFrame::Odometry{last_keyframe_->id, pose * last_keyframe_->world_from_cam(), *middle};
+    }
+  }
+  odometry_chain_ = true;
   reference_keyframe_ = keyframe;
   frame.reference_keyframe = keyframe;
   last_keyframe_ = keyframe;
