@@ -120,16 +120,11 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
   // With depth, the pose relative to the keyframe before, when every frame since was tracked: tracking
   // placed it with the last frame's depth points too, which never reach the map (KeyFrame::odometry).
   if (!options_.monocular && odometry_chain_ && last_keyframe_ && !last_keyframe_->is_bad()) {
-    std::vector<double> depths;
-    const geometry::SE3 pose = *frame.cam_from_world;
-    for (const auto& point : keyframe->valid_map_points()) {
-      const double z = (pose * point->world()).z();
-      if (z > 0) depths.push_back(z);
-    }
-    if (!depths.empty()) {
-      const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
-      std::nth_element(depths.begin(), middle, depths.end());
-      keyframe->odometry = map::KeyFrame::Odometry{last_keyframe_->id, pose * last_keyframe_->world_from_cam(), *middle};
+    const double median_depth = keyframe->scene_median_depth();
+    if (median_depth > 0) {
+      keyframe->odometry =
+          map::KeyFrame::Odometry{last_keyframe_->id, keyframe->cam_from_world() * last_keyframe_->world_from_cam(),
+                                  median_depth};
     }
   }
   odometry_chain_ = true;
