@@ -3,6 +3,7 @@
 // "bridged", never counted as tracked, written to BridgedTrajectory.txt only, and the run keeps one map.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -131,12 +132,37 @@ TEST(RunBlackout, MonocularReanchorsIntoTheSameMapWithTheScaleOfBefore) {
     if (f["state"] == "lost") ++lost_before;
   }
   ASSERT_GT(reanchor_s, 0);
-  EXPECT_GE(lost_before, 1);  // re-anchoring follows a loss; frames before it stay lost, not tracked
+  EXPECT_GE(lost_before, 1);  // re-anchoring follows a loss; frames before it are reported lost
+  // Lost frames the re-anchored map localised afterwards: reported lost, tracked in the trajectory.
+  std::set<long> recovered_ms;  // their time stamps, in ms
+  size_t ok_frames = 0;
+  size_t localized = 0;
+  for (const auto& f : doc["frames"]) {
+    if (f["state"] == "ok") ++ok_frames;
+    if (f["localized_after_init"].get<bool>()) ++localized;
+    if (!f["localized_after_reanchor"].get<bool>()) continue;
+    EXPECT_EQ(f["state"], "lost");
+    EXPECT_LT(f["timestamp"].get<double>(), reanchor_s);
+    recovered_ms.insert(std::lround(f["timestamp"].get<double>() * 1000));
+  }
+  EXPECT_EQ(recovered_ms.size(), doc["summary"]["frames_localized_after_reanchor"].get<size_t>());
+  EXPECT_GE(recovered_ms.size(), 1u);  // at least the re-anchoring's reference frame, now a keyframe
+  EXPECT_EQ(doc["summary"]["tracked_frames"].get<size_t>(), ok_frames + localized + recovered_ms.size());
   // Scale of the tracked poses before and after the re-anchoring, each aligned to the ground truth (Sim3).
   const auto camera = io::read_tum_trajectory((tmp / "mono" / "CameraTrajectory.txt").string());
   const auto truth = io::read_tum_trajectory((b.dir / "groundtruth.txt").string());
-  io::Trajectory before, after;
-  for (const auto& pose : camera) (pose.timestamp_s < reanchor_s ? before : after).push_back(pose);
+  io::Trajectory before, after, after_and_recovered;
+  size_t recovered_in_trajectory = 0;
+  for (const auto& pose : camera) {
+    if (recovered_ms.count(std::lround(pose.timestamp_s * 1000))) {
+      ++recovered_in_trajectory;
+      after_and_recovered.push_back(pose);
+      continue;
+    }
+    (pose.timestamp_s < reanchor_s ? before : after).push_back(pose);
+    if (pose.timestamp_s >= reanchor_s) after_and_recovered.push_back(pose);
+  }
+  EXPECT_EQ(recovered_in_trajectory, recovered_ms.size());
   ASSERT_GE(before.size(), 30u);
   ASSERT_GE(after.size(), 30u);
   eval::AteOptions sim3;
@@ -146,6 +172,14 @@ TEST(RunBlackout, MonocularReanchorsIntoTheSameMapWithTheScaleOfBefore) {
   std::printf("[ measured ] monocular blackout: re-anchored at %.2f s, scale before %.3f after %.3f, ATE %.4f m\n",
               reanchor_s, scale_before, scale_after, doc["summary"]["ate_rmse_m"].get<double>());
   EXPECT_NEAR(scale_after / scale_before, 1.0, 0.25);
+  // The recovered frames agree with the re-anchored part they were localised in.
+  std::sort(after_and_recovered.begin(), after_and_recovered.end(),
+            [](const auto& a, const auto& c) { return a.timestamp_s < c.timestamp_s; });
+  const double ate_after = eval::evaluate_ate(truth, after, sim3).translation_error_m.rmse;
+  const double ate_with_recovered = eval::evaluate_ate(truth, after_and_recovered, sim3).translation_error_m.rmse;
+  std::printf("[ measured ] %zu lost frames localised after the re-anchoring; ATE after %.4f m, with them %.4f m\n",
+              recovered_ms.size(), ate_after, ate_with_recovered);
+  EXPECT_LT(ate_with_recovered, 1.5 * ate_after + 0.005);
 
   // Without re-anchoring the camera stays lost, and a second later a new map starts.
   const auto without = run_on(b, tmp / "mono_without", "\nTracking.reanchor_max_s: 0\n", io::SensorKind::kMonocular);

@@ -74,7 +74,8 @@ nlohmann::json frame_json(const system::FrameReport& r) {
           {"method", r.method},
           {"keyframe", r.new_keyframe},
           {"waited_for_mapping_ms", r.waited_for_mapping_ms},
-          {"localized_after_init", false}};
+          {"localized_after_init", false},
+          {"localized_after_reanchor", false}};
 }
 
 nlohmann::json segment_json(const system::MapSegment& s) {
@@ -111,6 +112,7 @@ void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummar
   for (const auto& r : reports) {
     if (!summary.init_frame && r.method == std::string("init")) summary.init_frame = r.index;
     summary.frames_localized_before_init += r.localized_before_init.size();
+    summary.frames_localized_after_reanchor += r.localized_after_reanchor.size();
     if (r.state == tracking::TrackingState::kBridged) ++summary.bridged;
     tracking_ms.push_back(r.tracking_ms);
     extraction_ms.push_back(r.extraction_ms);
@@ -328,6 +330,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
       {"bridged_frames", summary.bridged},
       {"init_frame", summary.init_frame ? nlohmann::json(*summary.init_frame) : nlohmann::json(nullptr)},
       {"frames_localized_before_init", summary.frames_localized_before_init},
+      {"frames_localized_after_reanchor", summary.frames_localized_after_reanchor},
       {"wall_time_s", c.wall_s},
       {"throughput_fps", summary.throughput_fps},
       {"tracking_ms_median", summary.tracking_ms_median},
@@ -420,11 +423,14 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   doc["accuracy"] = accuracy;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& r : reports) frames.push_back(frame_json(r));
-  // Frames the monocular initialisation localised afterwards: tracked (they have a pose in the
-  // trajectory) although their own report, made before the map existed, says not initialised.
+  // Frames the monocular initialisation or re-anchoring localised afterwards: tracked (they have a pose in
+  // the trajectory) although their own report, made before, says not initialised or lost.
   for (const auto& r : reports) {
     for (const size_t index : r.localized_before_init) {
       if (index < frames.size()) frames[index]["localized_after_init"] = true;
+    }
+    for (const size_t index : r.localized_after_reanchor) {
+      if (index < frames.size()) frames[index]["localized_after_reanchor"] = true;
     }
   }
   doc["frames"] = std::move(frames);

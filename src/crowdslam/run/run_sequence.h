@@ -94,6 +94,7 @@ struct RunSummary {
   std::optional<size_t> init_frame;  // index of the first frame that initialised a map
   size_t frames_localized_before_init =
       0;  // monocular: earlier frames the new maps localised (included in tracked)
+  size_t frames_localized_after_reanchor = 0;  // monocular: lost frames a re-anchoring localised (in tracked)
   double throughput_fps = 0;
   double tracking_ms_median = 0;
   double tracking_ms_p95 = 0;

@@ -391,29 +391,28 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   records_.push_back(std::move(record));
   // Monocular initialisation makes its reference frame (an earlier frame, reported not initialised then)
   // the first keyframe: that frame's pose is the keyframe's, so it is tracked too. Earlier frames the map
-  // localises come with the initialising frame or, tried again once the map has grown, with a later one.
+  // localises come with the initialising frame or, tried again once the map has grown, with a later one;
+  // frames lost before a monocular re-anchoring come with the re-anchoring frame (its reference frame
+  // listed among them).
   const bool init = result.method == std::string("init");
-  const auto keyframes =
-      options_.sensor == io::SensorKind::kMonocular && (init || !result.recovered_before_init.empty())
-          ? map_->keyframes()  // sorted by id: the first is the reference frame's
-          : std::vector<std::shared_ptr<map::KeyFrame>>{};
-  if (!keyframes.empty() && keyframes.front()->frame_id < records_.size()) {
-    const auto& first = keyframes.front();
-    // The earlier frames the map localised (TrackResult::recovered_before_init), and the reference.
-    auto recovered = result.recovered_before_init;
+  const auto& first = result.recovered_reference;
+  if (options_.sensor == io::SensorKind::kMonocular && first && first->frame_id < records_.size()) {
+    const bool reanchored = result.method == std::string("reanchor");
+    auto recovered = result.recovered;
     if (init) recovered.emplace_back(first->frame_id, first->cam_from_world());
     for (const auto& [frame_id, cam_from_world] : recovered) {
       if (frame_id >= records_.size()) continue;
       TrajectoryRecord& earlier = records_[frame_id];
       if (earlier.tracked || earlier.segment != map_resets_) continue;
       earlier.tracked = true;
+      earlier.bridged = false;
       earlier.reference = first;
       earlier.cam_from_reference = cam_from_world * first->world_from_cam();
       earlier.world_from_cam = cam_from_world.inverse();
       MapSegment& current = segments_.back();
       if (current.tracked++ == 0 || earlier.timestamp_s < current.first_stamp_s) current.first_stamp_s = earlier.timestamp_s;
       if (earlier.timestamp_s > current.last_stamp_s) current.last_stamp_s = earlier.timestamp_s;
-      report.localized_before_init.push_back(frame_id);
+      (reanchored ? report.localized_after_reanchor : report.localized_before_init).push_back(frame_id);
     }
   }
   for (auto* observer : observers_) observer->on_frame(report, world_from_cam, images);

@@ -78,6 +78,10 @@ struct FrameReport {
   // reference frame, now the first keyframe, and those localised in the map); they count as tracked in
   // the trajectory and the summary, not in their own report.
   std::vector<size_t> localized_before_init;  // their indices
+  // Monocular re-anchoring: the frames lost before it that the re-anchored map gave a pose afterwards
+  // (the re-anchoring's reference frame, now a keyframe, among them); tracked in the trajectory and the
+  // summary, not in their own report.
+  std::vector<size_t> localized_after_reanchor;
   double waited_for_mapping_ms = 0;  // part of tracking_ms: waiting for local mapping to take a keyframe
   // People filter.
   int person_boxes = 0;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <numeric>
+#include <string_view>
 #include <unordered_set>
 
 #include "crowdslam/loop/keyframe_database.h"
@@ -66,7 +67,9 @@ void Tracker::reset() {
   last_tracked_s_.reset();
   last_bridged_s_.reset();
   bridge_motion_.reset();
+  bridge_recent_motion_.reset();
   reanchor_.reset();
+  frames_since_loss_.clear();
   recent_poses_.clear();
   next_frame_wait_ = NextFrameWait::kNone;
   state_ = TrackingState::kNotInitialized;
@@ -122,8 +125,9 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       state_ = TrackingState::kOk;
       result.method = "init";
       result.new_keyframe = true;
-      result.recovered_before_init = std::move(recovered_before_init_);
+      result.recovered = std::move(recovered_before_init_);
       recovered_before_init_.clear();
+      result.recovered_reference = map_->keyframes().front();
     }
   } else {
     bool ok = false;
@@ -158,15 +162,10 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     }
     bool in_local_map = false;
     size_t map_points_in_view = 0;  // where the bridge puts the frame
+    std::optional<geometry::SE3> bridged_guess;  // and where the keypoints outside boxes refine that to
     if (!ok && after_bridge && bridge(frame, motion)) {
-      // The local map of before the bridge, searched where the motion model puts the frame.
-      map::Frame guess = frame;
-      guess.reference_keyframe = reference_keyframe_;
-      if (track_local_map(guess)) {
-        frame = std::move(guess);
-        ok = in_local_map = true;
-        result.method = "motion";
-      }
+      ok = in_local_map = track_after_bridge(frame, motion, bridged_guess);
+      if (ok) result.method = "motion";
       map_points_in_view = projected_local_points_;
     }
     if (!ok) {
@@ -205,8 +204,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     }
     // While bridged, the keypoints in boxes are searched from where the bridge puts the frame: a person
     // close to a monocular camera hides the map outside the boxes, not behind them.
-    std::optional<geometry::SE3> bridged_guess;
-    if (!ok && after_bridge && motion) bridged_guess = motion->at(frame.timestamp_s);
+    if (!ok && after_bridge && motion && !bridged_guess) bridged_guess = motion->at(frame.timestamp_s);
     if (boxes && options_.box_keypoints &&
         (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking || bridged_guess)) {
       if (auto full = with_box_keypoints(frame, ok, boxes, result.static_boxes, bridged_guess)) {
@@ -250,7 +248,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       result.method = "bridged";
     }
     state_ = ok ? TrackingState::kOk : occluded ? TrackingState::kBridged : TrackingState::kLost;
-    if (!ok || bridged || after_bridge || (result.method != "motion" && result.method != "reference")) {
+    if (!ok || bridged || after_bridge || (std::string_view(result.method) != "motion" && std::string_view(result.method) != "reference")) {
       odometry_chain_ = false;
     }
     if (!ok) result.method = occluded ? "bridged" : "lost";
@@ -278,18 +276,24 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       if (reanchor_) {  // relocalised while re-anchoring was possible
         reanchor_.reset();
         reanchor_initializer_.reset();
+        frames_since_loss_.clear();
       }
       if (resumes) {
         velocity_ = geometry::SE3::exp(motion->twist_per_s * (frame.timestamp_s - last_frame_->timestamp_s));
       } else if (last_frame_ && last_frame_->cam_from_world && !after_bridge) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
+      } else if (const auto m = after_bridge ? motion_after_bridge(frame.timestamp_s, motion) : std::nullopt;
+                 m && last_frame_) {
+        // Tracked again after bridged frames: on at the motion they followed.
+        velocity_ = geometry::SE3::exp(m->twist_per_s * (frame.timestamp_s - last_frame_->timestamp_s));
       } else if (!options_.monocular) {
-        // Relocalised after lost or bridged frames: the next frame is looked for near this pose (no velocity known),
+        // Relocalised after lost frames: the next frame is looked for near this pose (no velocity known),
         // so the motion model and its depth points can take it.
         velocity_ = geometry::SE3();
       } else {
         velocity_.reset();
       }
+      bridge_recent_motion_.reset();
       if (!resumed) {
         recent_poses_.push_back({frame.timestamp_s, *frame.cam_from_world, inliers_in_local_map_});
         while (recent_poses_.size() > 30) recent_poses_.pop_front();
@@ -328,10 +332,15 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       }
       // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
       frame.discard_outliers();
-      if (!frames_to_retry_.empty()) result.recovered_before_init = retry_frames_before_init();
+      if (!frames_to_retry_.empty()) {
+        const auto first = retry_first_keyframe_;
+        result.recovered = retry_frames_before_init();
+        if (!result.recovered.empty()) result.recovered_reference = first;
+      }
     } else if (occluded) {
       // People hide the view: the motion model's pose, and no clock towards a new map.
       velocity_.reset();
+      if (!after_bridge) bridge_recent_motion_ = last_frame_motion(frame, velocity_at_start);
       bridge_motion_ = motion;
       last_bridged_s_ = frame.timestamp_s;
       lost_frames_ = 0;
@@ -347,7 +356,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       if (!last_tracked_s_) last_tracked_s_ = frame.timestamp_s;  // lost from its first frame (a new map)
       // The clock runs from the last frame with a pose; after a bridge, from when the view cleared.
       const double lost_s = std::abs(frame.timestamp_s - last_bridged_s_.value_or(*last_tracked_s_));
-      if (reanchor_ && reanchor(frame)) {
+      if (reanchor_ && reanchor(frame, result)) {
         state_ = TrackingState::kOk;
         result.method = "reanchor";
         result.new_keyframe = true;
@@ -379,55 +388,6 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
   frame.depth_raw.release();  // the caller's image: not kept beyond this call
   last_frame_ = std::move(frame);
   return result;
-}
-
-// ---- initialisation (RGB-D / stereo: one frame with depth) ----
-bool Tracker::initialize(map::Frame& frame) {
-  if (vocabulary_) ensure_bow(frame, *vocabulary_);  // the first keyframe carries its bag of words
-  const auto& f = *frame.features;
-  int with_depth = 0;
-  for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] > 0) ++with_depth;
-  }
-  if (with_depth < options_.min_init_features) return false;
-
-  frame.cam_from_world = geometry::SE3::identity();
-  auto keyframe =
-      std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
-                                      frame.levels, frame.features, *frame.cam_from_world);
-  map_->add_keyframe(keyframe);
-  for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] <= 0) continue;
-    auto point = make_point_from_depth(frame, i, keyframe, i);
-    frame.map_points[i] = point;
-  }
-  spdlog::info("map initialised with {} points at frame {}", map_->num_map_points(), frame.id);
-  mapper_->insert_keyframe(keyframe);
-  last_keyframe_ = keyframe;
-  last_keyframe_frame_id_ = frame.id;
-  odometry_chain_ = true;
-  reference_keyframe_ = keyframe;
-  frame.reference_keyframe = keyframe;
-  local_keyframes_ = {keyframe};
-  local_points_ = keyframe->valid_map_points();
-  inliers_in_local_map_ = static_cast<int>(local_points_.size());
-  return true;
-}
-
-std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& frame, size_t index,
-                                                              const std::shared_ptr<map::KeyFrame>& keyframe,
-                                                              size_t keyframe_index) const {
-  const auto& f = *frame.features;
-  const geometry::Vec2 pixel(f.keys_un[index].pt.x, f.keys_un[index].pt.y);
-  const geometry::Vec3 world =
-      frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[index]);
-  auto point = std::make_shared<map::MapPoint>(map_->next_map_point_id(), world, keyframe, frame.id);
-  point->add_observation(keyframe, keyframe_index);
-  keyframe->add_map_point(keyframe_index, point);
-  point->compute_distinctive_descriptor();
-  point->update_normal_and_depth();
-  map_->add_map_point(point);
-  return point;
 }
 
 // ---- relocalisation ----
@@ -594,7 +554,7 @@ bool Tracker::track_reference_keyframe(map::Frame& frame) {
 }
 
 // The occlusion bridge's motion: tracker_bridge.cpp; local-map tracking: tracker_local_map.cpp; keyframe
-// decisions and creation: tracker_keyframes.cpp;
+// decisions and creation, RGB-D / stereo initialisation: tracker_keyframes.cpp;
 // monocular parts: tracker_monocular.cpp.
 
 }  // namespace crowdslam::tracking

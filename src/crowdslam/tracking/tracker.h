@@ -115,6 +115,12 @@ struct TrackerOptions {
   // the frame is lost and relocalised instead: the map is there, and a keyframe at a drifted pose would
   // contradict it.
   int bridge_resume_max_map_points = 100;
+  // A pose predicted without a measurement (a bridged frame's, a failed frame's box rescue) is first
+  // refined on the local map searched in windows `prediction_radius_factor` times ORB-SLAM's base window
+  // (wider than local_map_radius_factor), when at least `prediction_min_inliers` of those matches agree;
+  // the usual local-map tracking then starts from the refined pose (0 = off).
+  double prediction_radius_factor = 4.0;
+  int prediction_min_inliers = 15;
   // Keypoints in person boxes (Tracker::track, BoxKeypoints): taken back for the pose when the filtered
   // frame tracks fewer than box_check_below points or fails, if they match map points seen at least
   // box_min_observations times (a depth observation counts twice) and judged moving at most once in
@@ -161,12 +167,18 @@ struct TrackResult {
   bool rescued_with_boxes = false;
   double waited_for_mapping_ms = 0;  // time this frame waited for local mapping to take its keyframe
   DynamicCheckStats dynamic;         // the geometric dynamic check of this frame (zeros when off or lost)
-  // Monocular initialisation (method "init"): the frames offered to the initializer before this one
-  // (since the last reset, at most kMaxFramesBeforeInit) that could be localised in the new map, as
-  // (frame id, cam_from_world). The initializer's reference frame is the first keyframe, not listed here.
-  // Frames before the reference that the two-view map could not localise are tried again once the map
-  // has grown (retry_frames_before_init); those found then are listed on that later frame's result.
-  std::vector<std::pair<uint64_t, geometry::SE3>> recovered_before_init;
+  // Earlier frames localised afterwards, as (frame id, cam_from_world), with the keyframe their poses
+  // hang from in the trajectory (`recovered_reference`):
+  // - monocular initialisation (method "init"): the frames offered to the initializer before this one
+  //   (since the last reset, at most kMaxFramesBeforeInit) that could be localised in the new map. The
+  //   initializer's reference frame is the first keyframe, not listed here. Frames before the reference
+  //   that the two-view map could not localise are tried again once the map has grown
+  //   (retry_frames_before_init); those found then are listed on that later frame's result;
+  // - monocular re-anchoring (method "reanchor"): the frames lost since tracking was lost (at most
+  //   kMaxFramesBeforeInit) that could be localised in the map with the two new keyframes, and the
+  //   re-anchoring's reference frame (the first new keyframe, `recovered_reference`).
+  std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
+  std::shared_ptr<map::KeyFrame> recovered_reference;
 };
 
 class Tracker {
@@ -274,14 +286,31 @@ class Tracker {
   // Whether `frame` can be bridged (TrackerOptions::bridge_max_s): within bridge_max_s of the last tracked
   // frame, with a motion to follow. Sets the frame's pose from it (no matches) if so.
   bool bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const;
+  // On from the last frame at `velocity` (its velocity when the frame came).
+  [[nodiscard]] std::optional<BridgeMotion> last_frame_motion(const map::Frame& frame,
+                                                              const std::optional<geometry::SE3>& velocity) const;
+  // The motion of bridged frames at time t: the last frame's before the bridge (bridge_recent_motion_)
+  // within kRecentBridgeS of it, else `motion` (the bridge's).
+  [[nodiscard]] std::optional<BridgeMotion> motion_after_bridge(double t, const std::optional<BridgeMotion>& motion) const;
+  // A frame after bridged ones, in the local map of before the bridge: from where the last frame before
+  // the bridge, moving on at its velocity, puts it (for kRecentBridgeS), then from where the bridge puts it
+  // (`frame`'s pose, set by bridge()); each refined first (refine_predicted_pose). True when tracked
+  // (frame then replaced). `guess` gets the best pose to search the keypoints in boxes from otherwise.
+  bool track_after_bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion,
+                          std::optional<geometry::SE3>& guess);
+  // TrackerOptions::prediction_radius_factor: refines frame.cam_from_world (a prediction) on the local
+  // map's points (those seen box_min_observations times and not judged moving, when `trusted_only`),
+  // matched in wide windows. The frame's matches are left empty. False (pose unchanged) when too few agree.
+  bool refine_predicted_pose(map::Frame& frame, bool trusted_only) const;
   // The motion bridge_motion() would follow, also when the bridge is off (monocular re-anchoring).
   [[nodiscard]] std::optional<BridgeMotion> recent_motion(const map::Frame& frame,
                                                           const std::optional<geometry::SE3>& velocity) const;
   // Monocular re-anchoring (TrackerOptions::reanchor_max_s, tracker_reanchor.cpp): remembers the motion
   // and scene depth at the loss; then offers each lost frame to the two-view initialisation and, when it
-  // succeeds, adds its two keyframes to the map where that motion puts them. True when `frame` is tracked.
+  // succeeds, adds its two keyframes to the map where that motion puts them, and localises the frames lost
+  // meanwhile in it (result.recovered). True when `frame` is tracked.
   void start_reanchor(const std::optional<BridgeMotion>& motion, double lost_since_s);
-  bool reanchor(map::Frame& frame);
+  bool reanchor(map::Frame& frame, TrackResult& result);
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
@@ -315,6 +344,7 @@ class Tracker {
   int lost_frames_ = 0;                   // consecutive lost frames (new_map_after_lost_min_frames)
   std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)
   std::optional<BridgeMotion> bridge_motion_;  // while bridging
+  std::optional<BridgeMotion> bridge_recent_motion_;  // the last frame before the bridge at its velocity
   struct Reanchor {
     BridgeMotion motion;          // from the last pose before the loss
     double lost_since_s = 0;      // the first lost frame (after a bridge: when the view cleared)
@@ -322,6 +352,7 @@ class Tracker {
     std::shared_ptr<map::KeyFrame> keyframe;  // that reference keyframe (the new part's parent)
   };
   std::optional<Reanchor> reanchor_;  // while lost in a monocular map that may be re-anchored
+  std::deque<map::Frame> frames_since_loss_;  // the lost frames while re-anchoring (oldest first)
   struct RecentPose {
     double timestamp_s = 0;
     geometry::SE3 cam_from_world;

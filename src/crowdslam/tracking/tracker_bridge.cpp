@@ -2,6 +2,10 @@
 // frames people hide entirely follow until the view clears.
 #include <cmath>
 
+#include "crowdslam/map/map_point.h"
+#include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/tracking/pose_refinement.h"
+
 #include "crowdslam/tracking/tracker.h"
 
 namespace crowdslam::tracking {
@@ -31,16 +35,87 @@ std::optional<Tracker::BridgeMotion> Tracker::recent_motion(const map::Frame& fr
                         step.log() / (anchor->timestamp_s - base->timestamp_s)};
   }
   // Not enough reliable frames: on from the last frame at its velocity.
+  return last_frame_motion(frame, velocity);
+}
+
+std::optional<Tracker::BridgeMotion> Tracker::last_frame_motion(const map::Frame& frame,
+                                                                 const std::optional<geometry::SE3>& velocity) const {
   if (!velocity || !last_frame_ || !last_frame_->cam_from_world) return std::nullopt;
   const double dt = frame.timestamp_s - last_frame_->timestamp_s;
   if (!(dt > 0)) return std::nullopt;
   return BridgeMotion{last_frame_->timestamp_s, *last_frame_->cam_from_world, velocity->log() / dt};
 }
 
+namespace {
+// The bridge follows the motion of the frames tracked on many points before the occlusion (up to half a
+// second before it). When people close in over a few frames, those last frames are tracked on little,
+// but a short gap after them is still best bridged by their own motion.
+constexpr double kRecentBridgeS = 0.5;
+}  // namespace
+
+std::optional<Tracker::BridgeMotion> Tracker::motion_after_bridge(double t,
+                                                                   const std::optional<BridgeMotion>& motion) const {
+  if (bridge_recent_motion_ && t - bridge_recent_motion_->anchor_s <= kRecentBridgeS) return bridge_recent_motion_;
+  return motion;
+}
+
+bool Tracker::track_after_bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion,
+                                 std::optional<geometry::SE3>& guess) {
+  std::vector<geometry::SE3> predictions;
+  if (bridge_recent_motion_ && frame.timestamp_s - bridge_recent_motion_->anchor_s <= kRecentBridgeS) {
+    predictions.push_back(bridge_recent_motion_->at(frame.timestamp_s));
+  }
+  if (motion) predictions.push_back(motion->at(frame.timestamp_s));
+  std::optional<geometry::SE3> refined;
+  for (const auto& prediction : predictions) {
+    map::Frame candidate = frame;
+    candidate.cam_from_world = prediction;
+    candidate.reference_keyframe = reference_keyframe_;
+    if (refine_predicted_pose(candidate, false) && !refined) refined = candidate.cam_from_world;
+    if (track_local_map(candidate)) {
+      frame = std::move(candidate);
+      return true;
+    }
+  }
+  if (refined) {
+    guess = refined;
+  } else if (!predictions.empty()) {
+    guess = predictions.front();
+  }
+  return false;
+}
+
 bool Tracker::bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const {
   if (options_.bridge_max_s <= 0 || !motion || !last_tracked_s_) return false;
   if (std::abs(frame.timestamp_s - *last_tracked_s_) > options_.bridge_max_s) return false;
   frame.cam_from_world = motion->at(frame.timestamp_s);
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  std::fill(frame.outliers.begin(), frame.outliers.end(), false);
+  return true;
+}
+
+bool Tracker::refine_predicted_pose(map::Frame& frame, bool trusted_only) const {
+  // A bridged pose follows the motion of up to half a second before the occlusion, frames ago: a few
+  // pixels off already exceeds the local-map window (2.5-4 px at level 0 in monocular), and a frame whose
+  // static part is a strip between people then finds too few of its points there.
+  if (!(options_.prediction_radius_factor > 0) || !frame.cam_from_world || local_points_.empty()) return false;
+  map::Frame probe = frame;
+  std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
+  std::fill(probe.outliers.begin(), probe.outliers.end(), false);
+  std::vector<match::ProjectedPoint> projected;
+  projected.reserve(local_points_.size());
+  for (const auto& p : local_points_) {
+    if (!p || p->is_bad()) continue;
+    if (trusted_only && (p->num_observations() < options_.box_min_observations || p->motion_score() > 1)) continue;
+    if (auto projection = probe.project(*p, 0.5)) projected.push_back({p, *projection});
+  }
+  if (projected.empty()) return false;
+  if (match::search_local_points(probe, projected, options_.prediction_radius_factor) <
+      options_.prediction_min_inliers) {
+    return false;
+  }
+  if (optimize_frame_pose(probe, options_.pose) < options_.prediction_min_inliers) return false;
+  frame.cam_from_world = probe.cam_from_world;
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   std::fill(frame.outliers.begin(), frame.outliers.end(), false);
   return true;

@@ -1,5 +1,8 @@
 // The tracker's keyframe decisions (RGB-D / stereo; the monocular policy is in tracker_monocular.cpp) and
-// the making of a keyframe from the current frame, with its points from depth.
+// the making of a keyframe from the current frame, with its points from depth; the RGB-D / stereo
+// initialisation from one frame with depth.
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <numeric>
 
@@ -138,6 +141,55 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
     last_keyframe_indices_.clear();
   }
   mapper_->insert_keyframe(keyframe);
+}
+
+// ---- initialisation (RGB-D / stereo: one frame with depth) ----
+bool Tracker::initialize(map::Frame& frame) {
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);  // the first keyframe carries its bag of words
+  const auto& f = *frame.features;
+  int with_depth = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0) ++with_depth;
+  }
+  if (with_depth < options_.min_init_features) return false;
+
+  frame.cam_from_world = geometry::SE3::identity();
+  auto keyframe =
+      std::make_shared<map::KeyFrame>(map_->next_keyframe_id(), frame.id, frame.timestamp_s, frame.camera,
+                                      frame.levels, frame.features, *frame.cam_from_world);
+  map_->add_keyframe(keyframe);
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] <= 0) continue;
+    auto point = make_point_from_depth(frame, i, keyframe, i);
+    frame.map_points[i] = point;
+  }
+  spdlog::info("map initialised with {} points at frame {}", map_->num_map_points(), frame.id);
+  mapper_->insert_keyframe(keyframe);
+  last_keyframe_ = keyframe;
+  last_keyframe_frame_id_ = frame.id;
+  odometry_chain_ = true;
+  reference_keyframe_ = keyframe;
+  frame.reference_keyframe = keyframe;
+  local_keyframes_ = {keyframe};
+  local_points_ = keyframe->valid_map_points();
+  inliers_in_local_map_ = static_cast<int>(local_points_.size());
+  return true;
+}
+
+std::shared_ptr<map::MapPoint> Tracker::make_point_from_depth(const map::Frame& frame, size_t index,
+                                                              const std::shared_ptr<map::KeyFrame>& keyframe,
+                                                              size_t keyframe_index) const {
+  const auto& f = *frame.features;
+  const geometry::Vec2 pixel(f.keys_un[index].pt.x, f.keys_un[index].pt.y);
+  const geometry::Vec3 world =
+      frame.cam_from_world->inverse() * frame.camera->unproject(pixel, f.depth_m[index]);
+  auto point = std::make_shared<map::MapPoint>(map_->next_map_point_id(), world, keyframe, frame.id);
+  point->add_observation(keyframe, keyframe_index);
+  keyframe->add_map_point(keyframe_index, point);
+  point->compute_distinctive_descriptor();
+  point->update_normal_and_depth();
+  map_->add_map_point(point);
+  return point;
 }
 
 }  // namespace crowdslam::tracking

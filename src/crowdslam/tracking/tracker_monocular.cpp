@@ -9,6 +9,7 @@
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/tracking/frame_bow.h"
+#include "crowdslam/tracking/localize_frames.h"
 #include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/tracking/tracker.h"
 
@@ -61,59 +62,6 @@ void Tracker::track_from_two_views(const std::shared_ptr<map::KeyFrame>& first,
   velocity_.reset();  // the next frame is tracked against the reference keyframe
 }
 
-namespace {
-
-// The pose a fraction `t` of the way from `a` to `b` (camera centres on the line, rotations slerped).
-geometry::SE3 interpolate(const geometry::SE3& a, const geometry::SE3& b, double t) {
-  const geometry::SE3 wa = a.inverse();
-  const geometry::SE3 wb = b.inverse();
-  const Eigen::Quaterniond q = wa.rotation().slerp(t, wb.rotation());
-  const geometry::Vec3 c = (1 - t) * wa.translation() + t * wb.translation();
-  return geometry::SE3(q, c).inverse();
-}
-
-// A frame before the initialisation, matched by projection to `points` from the pose guess, wide then
-// narrow, and its pose optimised; it counts when it keeps the 50 inliers a pose from new matches needs
-// (as relocalisation).
-std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::SE3& guess,
-                                             const std::vector<std::shared_ptr<map::MapPoint>>& points,
-                                             const optim::PoseOptimizerOptions& options) {
-  constexpr int kMinInliers = 50;
-  frame.cam_from_world = guess;
-  for (const double radius_factor : {6.0, 1.5}) {
-    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-    std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-    std::vector<match::ProjectedPoint> projected;
-    for (const auto& p : points) {
-      if (!p || p->is_bad()) continue;
-      if (auto projection = frame.project(*p, 0.5)) projected.push_back({p, *projection});
-    }
-    match::search_local_points(frame, projected, radius_factor);
-    if (optimize_frame_pose(frame, options) < kMinInliers) return std::nullopt;
-  }
-  return frame.cam_from_world;
-}
-
-// Frames before `later` (newest first in `frames`, which keeps those that fail), each from the pose of the
-// frame after it moved by the last measured step; stops at the first failure.
-// `step` is cam_from_world(earlier) * world_from_cam(later) for one frame interval, as last measured.
-std::vector<std::pair<uint64_t, geometry::SE3>> localize_backwards(
-    std::deque<map::Frame>& frames, geometry::SE3& later, geometry::SE3& step,
-    const std::vector<std::shared_ptr<map::MapPoint>>& points, const optim::PoseOptimizerOptions& options) {
-  std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
-  while (!frames.empty()) {
-    const auto pose = localize_in_map(frames.back(), step * later, points, options);
-    if (!pose) break;
-    step = *pose * later.inverse();
-    later = *pose;
-    recovered.emplace_back(frames.back().id, *pose);
-    frames.pop_back();
-  }
-  return recovered;
-}
-
-}  // namespace
-
 std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_init(
     const map::Frame& init_frame, uint64_t reference_id) {
   // The frames the initializer saw before the frame that initialised: those after its reference frame
@@ -121,45 +69,21 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   // are taken backwards from it (guess: the pose of the frame after, moved by the velocity between the
   // two frames after). Frames between the keyframes that fail are left lost; going backwards stops at
   // the first failure, and the frames left are tried again when the map has grown (retry).
-  std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
   frames_to_retry_.clear();
   retries_before_init_ = 0;
-  if (frames_before_init_.empty() || !init_frame.cam_from_world) return recovered;
-  const auto points = map_->map_points();
+  if (frames_before_init_.empty() || !init_frame.cam_from_world) return {};
   const auto reference_kf = map_->keyframes().front();  // sorted by id: the reference frame's keyframe
-  const geometry::SE3 first_pose = reference_kf->cam_from_world();
-  const geometry::SE3 last_pose = *init_frame.cam_from_world;
-  const double t0 = reference_kf->timestamp_s;
-  const double t1 = init_frame.timestamp_s;
-  // Between the reference frame and the initialising frame.
-  for (const auto& frame : frames_before_init_) {
-    if (frame.id <= reference_id || t1 <= t0) continue;
-    const double t = std::clamp((frame.timestamp_s - t0) / (t1 - t0), 0.0, 1.0);
-    if (auto pose = localize_in_map(frame, interpolate(first_pose, last_pose, t), points, options_.pose)) {
-      recovered.emplace_back(frame.id, *pose);
-    }
-  }
-  // Before the reference frame, newest first.
-  for (auto& frame : frames_before_init_) {
-    if (frame.id < reference_id) frames_to_retry_.push_back(std::move(frame));
-  }
-  // The first step back: the motion between the two keyframes, extrapolated by time to the frame before.
-  geometry::SE3 later = first_pose;
-  retry_step_ = geometry::SE3();
-  if (!frames_to_retry_.empty() && t1 > t0) {
-    const double t = (frames_to_retry_.back().timestamp_s - t0) / (t1 - t0);
-    retry_step_ = interpolate(first_pose, last_pose, std::max(t, -1.0)) * first_pose.inverse();
-  }
-  const auto before = localize_backwards(frames_to_retry_, later, retry_step_, points, options_.pose);
-  recovered.insert(recovered.end(), before.begin(), before.end());
-  retry_anchor_from_first_ = later * first_pose.inverse();
+  auto around = localize_around_two_views(std::move(frames_before_init_), reference_id, reference_kf->cam_from_world(),
+                                          reference_kf->timestamp_s, *init_frame.cam_from_world,
+                                          init_frame.timestamp_s, map_->map_points(), options_.pose);
+  frames_to_retry_ = std::move(around.left);
+  retry_step_ = around.step;
+  retry_anchor_from_first_ = around.later * reference_kf->world_from_cam();
   retry_first_keyframe_ = reference_kf;
-  std::sort(recovered.begin(), recovered.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  if (!recovered.empty()) {
-    spdlog::info("monocular initialisation: {} earlier frames localised in the new map", recovered.size());
+  if (!around.recovered.empty()) {
+    spdlog::info("monocular initialisation: {} earlier frames localised in the new map", around.recovered.size());
   }
-  return recovered;
+  return std::move(around.recovered);
 }
 
 std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_init() {

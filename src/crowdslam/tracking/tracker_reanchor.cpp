@@ -8,6 +8,7 @@
 
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/tracking/frame_bow.h"
+#include "crowdslam/tracking/localize_frames.h"
 #include "crowdslam/tracking/tracker.h"
 
 namespace crowdslam::tracking {
@@ -24,6 +25,7 @@ MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOpt
 void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double lost_since_s) {
   reanchor_.reset();
   reanchor_initializer_.reset();
+  frames_since_loss_.clear();
   if (options_.reanchor_max_s <= 0 || !motion || map_loaded_ || localization_only_) return;
   if (map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) return;
   const auto reference = reference_keyframe_ && !reference_keyframe_->is_bad() ? reference_keyframe_ : last_keyframe_;
@@ -32,17 +34,26 @@ void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double l
   reanchor_ = Reanchor{*motion, lost_since_s, depth, reference};
 }
 
-bool Tracker::reanchor(map::Frame& frame) {
+bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
   // Counted from the loss, like the new-map clock: after a bridge, from when the view cleared.
   if (frame.timestamp_s - reanchor_->lost_since_s > options_.reanchor_max_s) {
     spdlog::info("monocular re-anchoring given up {:.1f} s after tracking was lost", options_.reanchor_max_s);
     reanchor_.reset();
     reanchor_initializer_.reset();
+    frames_since_loss_.clear();
     return false;
   }
   if (vocabulary_) ensure_bow(frame, *vocabulary_);  // either frame may become a keyframe
   const auto init = reanchor_initializer_.add_frame(frame);
-  if (!init) return false;
+  // The lost frames are kept, to be localised in the map once it is re-anchored.
+  const auto keep = [&] {
+    frames_since_loss_.push_back(frame);
+    if (frames_since_loss_.size() > kMaxFramesBeforeInit) frames_since_loss_.pop_front();
+  };
+  if (!init) {
+    keep();
+    return false;
+  }
   const BridgeMotion& motion = reanchor_->motion;
   InitialMapPlacement placement;
   placement.reference_cam_from_world = motion.at(init->reference->timestamp_s);
@@ -66,6 +77,7 @@ bool Tracker::reanchor(map::Frame& frame) {
     reanchor_initializer_.add_frame(frame);
     frame.cam_from_world.reset();
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    keep();
     return false;
   }
   const auto& [first, second] = *keyframes;
@@ -76,6 +88,17 @@ bool Tracker::reanchor(map::Frame& frame) {
       placement.scaled_by_baseline ? "predicted baseline" : "scene depth", second->tracked_map_points(1));
   track_from_two_views(first, second, frame, second->valid_map_points());
   frame.discard_outliers();
+  // The frames lost before: between the two views, and before the first (backwards from it).
+  auto around = localize_around_two_views(std::move(frames_since_loss_), first->frame_id, first->cam_from_world(),
+                                          first->timestamp_s, *frame.cam_from_world, frame.timestamp_s,
+                                          map_->map_points(), options_.pose);
+  frames_since_loss_.clear();
+  result.recovered = std::move(around.recovered);
+  result.recovered.emplace_back(first->frame_id, first->cam_from_world());
+  result.recovered_reference = first;
+  if (result.recovered.size() > 1) {
+    spdlog::info("monocular re-anchoring: {} lost frames localised in the map", result.recovered.size() - 1);
+  }
   reanchor_initializer_.reset();
   reanchor_.reset();
   lost_frames_ = 0;
