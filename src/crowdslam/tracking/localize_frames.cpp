@@ -16,21 +16,33 @@ geometry::SE3 interpolate_pose(const geometry::SE3& a, const geometry::SE3& b, d
   return geometry::SE3(q, c).inverse();
 }
 
+int match_projected_and_optimize(map::Frame& frame, const std::vector<std::shared_ptr<map::MapPoint>>& points,
+                                 double radius_factor, const optim::PoseOptimizerOptions& options) {
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  std::fill(frame.outliers.begin(), frame.outliers.end(), false);
+  std::vector<match::ProjectedPoint> projected;
+  projected.reserve(points.size());
+  for (const auto& p : points) {
+    if (!p || p->is_bad()) continue;
+    if (auto projection = frame.project(*p, 0.5)) projected.push_back({p, *projection});
+  }
+  if (projected.empty()) return 0;
+  match::search_local_points(frame, projected, radius_factor);
+  return optimize_frame_pose(frame, options);
+}
+
+void keep_last_frames(std::deque<map::Frame>& frames, const map::Frame& frame, size_t max) {
+  frames.push_back(frame);
+  while (frames.size() > max) frames.pop_front();
+}
+
 std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::SE3& guess,
                                              const std::vector<std::shared_ptr<map::MapPoint>>& points,
                                              const optim::PoseOptimizerOptions& options) {
   constexpr int kMinInliers = 50;
   frame.cam_from_world = guess;
   for (const double radius_factor : {6.0, 1.5}) {
-    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-    std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-    std::vector<match::ProjectedPoint> projected;
-    for (const auto& p : points) {
-      if (!p || p->is_bad()) continue;
-      if (auto projection = frame.project(*p, 0.5)) projected.push_back({p, *projection});
-    }
-    match::search_local_points(frame, projected, radius_factor);
-    if (optimize_frame_pose(frame, options) < kMinInliers) return std::nullopt;
+    if (match_projected_and_optimize(frame, points, radius_factor, options) < kMinInliers) return std::nullopt;
   }
   return frame.cam_from_world;
 }

@@ -19,6 +19,14 @@ using FramePoses = std::vector<std::pair<uint64_t, geometry::SE3>>;  // (frame i
 // The pose a fraction `t` of the way from `a` to `b` (camera centres on the line, rotations slerped).
 geometry::SE3 interpolate_pose(const geometry::SE3& a, const geometry::SE3& b, double t);
 
+// `frame`'s matches replaced by those of `points` projected from its pose (searched with
+// match::search_local_points' `radius_factor`), and its pose optimised on them; the inliers.
+int match_projected_and_optimize(map::Frame& frame, const std::vector<std::shared_ptr<map::MapPoint>>& points,
+                                 double radius_factor, const optim::PoseOptimizerOptions& options);
+
+// `frames` holds at most `max` frames: `frame` is appended, the oldest dropped.
+void keep_last_frames(std::deque<map::Frame>& frames, const map::Frame& frame, size_t max);
+
 // `frame` matched by projection to `points` from the pose guess, wide then narrow, and its pose optimised;
 // it counts when it keeps the 50 inliers a pose from new matches needs (as relocalisation).
 std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::SE3& guess,

@@ -115,7 +115,7 @@ struct TrackerOptions {
   // the frame is lost and relocalised instead: the map is there, and a keyframe at a drifted pose would
   // contradict it.
   int bridge_resume_max_map_points = 100;
-  // A pose predicted without a measurement (a bridged frame's, a failed frame's box rescue) is first
+  // A pose predicted without a measurement (a frame's after bridged frames) is first
   // refined on the local map searched in windows `prediction_radius_factor` times ORB-SLAM's base window
   // (wider than local_map_radius_factor), when at least `prediction_min_inliers` of those matches agree;
   // the usual local-map tracking then starts from the refined pose (0 = off).
@@ -299,9 +299,9 @@ class Tracker {
   bool track_after_bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion,
                           std::optional<geometry::SE3>& guess);
   // TrackerOptions::prediction_radius_factor: refines frame.cam_from_world (a prediction) on the local
-  // map's points (those seen box_min_observations times and not judged moving, when `trusted_only`),
-  // matched in wide windows. The frame's matches are left empty. False (pose unchanged) when too few agree.
-  bool refine_predicted_pose(map::Frame& frame, bool trusted_only) const;
+  // map's points matched in wide windows. The frame's matches are left empty. False (pose unchanged) when
+  // too few agree.
+  bool refine_predicted_pose(map::Frame& frame) const;
   // The motion bridge_motion() would follow, also when the bridge is off (monocular re-anchoring).
   [[nodiscard]] std::optional<BridgeMotion> recent_motion(const map::Frame& frame,
                                                           const std::optional<geometry::SE3>& velocity) const;

@@ -2,9 +2,7 @@
 // frames people hide entirely follow until the view clears.
 #include <cmath>
 
-#include "crowdslam/map/map_point.h"
-#include "crowdslam/match/orb_matcher.h"
-#include "crowdslam/tracking/pose_refinement.h"
+#include "crowdslam/tracking/localize_frames.h"
 
 #include "crowdslam/tracking/tracker.h"
 
@@ -71,7 +69,7 @@ bool Tracker::track_after_bridge(map::Frame& frame, const std::optional<BridgeMo
     map::Frame candidate = frame;
     candidate.cam_from_world = prediction;
     candidate.reference_keyframe = reference_keyframe_;
-    if (refine_predicted_pose(candidate, false) && !refined) refined = candidate.cam_from_world;
+    if (refine_predicted_pose(candidate) && !refined) refined = candidate.cam_from_world;
     if (track_local_map(candidate)) {
       frame = std::move(candidate);
       return true;
@@ -94,27 +92,16 @@ bool Tracker::bridge(map::Frame& frame, const std::optional<BridgeMotion>& motio
   return true;
 }
 
-bool Tracker::refine_predicted_pose(map::Frame& frame, bool trusted_only) const {
+bool Tracker::refine_predicted_pose(map::Frame& frame) const {
   // A bridged pose follows the motion of up to half a second before the occlusion, frames ago: a few
   // pixels off already exceeds the local-map window (2.5-4 px at level 0 in monocular), and a frame whose
   // static part is a strip between people then finds too few of its points there.
-  if (!(options_.prediction_radius_factor > 0) || !frame.cam_from_world || local_points_.empty()) return false;
+  if (!(options_.prediction_radius_factor > 0) || !frame.cam_from_world) return false;
   map::Frame probe = frame;
-  std::fill(probe.map_points.begin(), probe.map_points.end(), nullptr);
-  std::fill(probe.outliers.begin(), probe.outliers.end(), false);
-  std::vector<match::ProjectedPoint> projected;
-  projected.reserve(local_points_.size());
-  for (const auto& p : local_points_) {
-    if (!p || p->is_bad()) continue;
-    if (trusted_only && (p->num_observations() < options_.box_min_observations || p->motion_score() > 1)) continue;
-    if (auto projection = probe.project(*p, 0.5)) projected.push_back({p, *projection});
-  }
-  if (projected.empty()) return false;
-  if (match::search_local_points(probe, projected, options_.prediction_radius_factor) <
+  if (match_projected_and_optimize(probe, local_points_, options_.prediction_radius_factor, options_.pose) <
       options_.prediction_min_inliers) {
     return false;
   }
-  if (optimize_frame_pose(probe, options_.pose) < options_.prediction_min_inliers) return false;
   frame.cam_from_world = probe.cam_from_world;
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   std::fill(frame.outliers.begin(), frame.outliers.end(), false);

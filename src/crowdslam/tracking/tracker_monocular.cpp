@@ -7,10 +7,8 @@
 #include <algorithm>
 
 #include "crowdslam/map/map_point.h"
-#include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/tracking/frame_bow.h"
 #include "crowdslam/tracking/localize_frames.h"
-#include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/tracking/tracker.h"
 
 namespace crowdslam::tracking {
@@ -20,10 +18,7 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
   // database, loop closing): computed before the initializer keeps a copy of the frame.
   if (vocabulary_) ensure_bow(frame, *vocabulary_);
   const auto init = monocular_initializer_.add_frame(frame);
-  const auto remember = [&] {
-    frames_before_init_.push_back(frame);
-    if (frames_before_init_.size() > kMaxFramesBeforeInit) frames_before_init_.pop_front();
-  };
+  const auto remember = [&] { keep_last_frames(frames_before_init_, frame, kMaxFramesBeforeInit); };
   if (!init) {
     remember();
     return false;

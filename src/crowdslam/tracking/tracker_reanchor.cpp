@@ -46,10 +46,7 @@ bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
   if (vocabulary_) ensure_bow(frame, *vocabulary_);  // either frame may become a keyframe
   const auto init = reanchor_initializer_.add_frame(frame);
   // The lost frames are kept, to be localised in the map once it is re-anchored.
-  const auto keep = [&] {
-    frames_since_loss_.push_back(frame);
-    if (frames_since_loss_.size() > kMaxFramesBeforeInit) frames_since_loss_.pop_front();
-  };
+  const auto keep = [&] { keep_last_frames(frames_since_loss_, frame, kMaxFramesBeforeInit); };
   if (!init) {
     keep();
     return false;
