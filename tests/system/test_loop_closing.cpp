@@ -87,3 +87,38 @@ TEST(LoopClosing, TwoLapsWithDepthNoiseLoopFoundAndAteHalved) {
   const auto quarter = run_slam(dataset, tmp / "quarter", true, 150);
   EXPECT_EQ(quarter.json["loop_closing"]["loops"].size(), 0u);
 }
+
+// A loop first seen by the last keyframes of a run (the camera is back at its start just before the end)
+// can never become consistent over three keyframes; it is closed when the keyframe's covisible keyframes
+// confirm it (LoopCloserOptions::covisible_confirmations), and it joins the right places.
+TEST(LoopClosing, LoopSeenOnlyAtTheEndIsConfirmedByCovisibleKeyframes) {
+  if (!std::filesystem::exists(bow::default_vocabulary_path())) {
+    GTEST_SKIP() << "default vocabulary " << bow::default_vocabulary_path() << " missing (scripts/build_vocabulary.sh)";
+  }
+  test::TempDir tmp;
+  synth::SynthOptions synth_options;
+  synth_options.frames = 300;  // one lap, back at the start in the last frames
+  synth_options.trajectory = synth::TrajectoryKind::kLoop;
+  synth_options.seed = 1;
+  synth_options.width = 480;
+  synth_options.height = 360;
+  const auto dataset = tmp / "lap";
+  synth::write_sequence(synth_options, dataset);
+
+  // 288 frames: the run ends 0.4 s after the first keyframe that sees the start again.
+  const auto without = run_slam(dataset, tmp / "without", false, 288);
+  const auto with = run_slam(dataset, tmp / "with", true, 288);
+  ASSERT_TRUE(without.ate_rmse_m && with.ate_rmse_m);
+  const auto& closing = with.json["loop_closing"];
+  const auto& loops = closing["loops"];
+  std::printf("ATE without loop closing %.4f m, with %.4f m; %zu loop(s), %d confirmed by covisible keyframes\n",
+              *without.ate_rmse_m, *with.ate_rmse_m, loops.size(), closing["loops_confirmed_by_covisibles"].get<int>());
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(closing["loops_confirmed_by_covisibles"].get<int>(), 1);
+  EXPECT_LE(*with.ate_rmse_m, 0.75 * *without.ate_rmse_m);
+  const io::Trajectory gt = io::read_tum_trajectory((dataset / "groundtruth.txt").string());
+  const auto* current = pose_at(gt, loops[0]["timestamp"].get<double>());
+  const auto* previous = pose_at(gt, loops[0]["loop_timestamp"].get<double>());
+  ASSERT_TRUE(current != nullptr && previous != nullptr);
+  EXPECT_LT((current->world_from_cam.translation() - previous->world_from_cam.translation()).norm(), 0.5);
+}

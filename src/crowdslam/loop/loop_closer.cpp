@@ -24,6 +24,8 @@ void LoopCloserOptions::check() const {
   require(min_bow_matches >= 3, "min_bow_matches");
   require(min_sim3_inliers >= 3, "min_sim3_inliers");
   require(min_total_matches >= min_sim3_inliers, "min_total_matches");
+  require(covisible_confirmations >= 0, "covisible_confirmations");
+  require(immediate_candidates >= 0, "immediate_candidates");
   require(essential_graph_min_weight >= 1, "essential_graph_min_weight");
   require(essential_graph_iterations >= 1, "essential_graph_iterations");
   require(global_ba_iterations >= 1, "global_ba_iterations");
@@ -127,17 +129,28 @@ LoopCloserStats LoopCloser::stats() const {
 void LoopCloser::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe, bool inline_mode) {
   if (!database_ || keyframe->is_bad() || !keyframe->features->has_bow()) return;
   const auto start = std::chrono::steady_clock::now();
-  std::vector<std::shared_ptr<map::KeyFrame>> candidates;
+  LoopDetector::Detection candidates;
   const bool too_early = map_->num_keyframes() < static_cast<size_t>(options_.min_map_keyframes) ||
                          (any_loop_ && keyframe->id < last_loop_keyframe_id_ + options_.min_keyframes_since_loop);
   if (!too_early) candidates = detector_.detect(*keyframe, *database_);
   Candidate loop;
-  const bool accepted = !candidates.empty() && verify(keyframe, candidates, loop);
+  const bool consistent_accepted = !candidates.consistent.empty() && verify(keyframe, candidates.consistent, loop);
+  bool confirmed = false;
+  if (!consistent_accepted && options_.covisible_confirmations > 0 && options_.immediate_candidates > 0 &&
+      !candidates.others.empty()) {
+    auto& others = candidates.others;
+    if (others.size() > static_cast<size_t>(options_.immediate_candidates)) {
+      others.resize(static_cast<size_t>(options_.immediate_candidates));
+    }
+    confirmed = verify(keyframe, others, loop, options_.covisible_confirmations);
+  }
+  const bool accepted = consistent_accepted || confirmed;
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.keyframes_checked;
-    stats_.candidates_consistent += static_cast<int>(candidates.size());
-    if (!candidates.empty() && !accepted) ++stats_.candidates_rejected;
+    stats_.candidates_consistent += static_cast<int>(candidates.consistent.size());
+    if (!candidates.consistent.empty() && !consistent_accepted) ++stats_.candidates_rejected;
+    if (confirmed) ++stats_.loops_confirmed_by_covisibles;
     stats_.detection_ms_total +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
@@ -166,6 +179,9 @@ void LoopCloser::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe
 }
 
 namespace {
+
+// Covisible keyframes tried when confirming a loop candidate that is not yet consistent.
+constexpr size_t kConfirmingNeighbours = 5;
 
 // 3D-3D correspondences from BoW matches: point i of kf1 with its match in kf2.
 std::vector<geometry::Sim3Match> sim3_matches(const map::KeyFrame& kf1, const map::KeyFrame& kf2,
@@ -205,8 +221,29 @@ int count_matched(const std::vector<std::shared_ptr<map::MapPoint>>& matched) {
 
 }  // namespace
 
+int LoopCloser::covisible_confirmations(const map::KeyFrame& keyframe, const Candidate& candidate,
+                                        int needed) const {
+  const geometry::SE3 world_from_cam = keyframe.cam_from_world().inverse();
+  int confirmed = 0;
+  for (const auto& covisible : keyframe.best_covisible(kConfirmingNeighbours)) {
+    if (confirmed >= needed) break;
+    if (covisible->is_bad()) continue;
+    // The covisible keyframe moved with the keyframe: its pose relative to it kept.
+    const geometry::Sim3 cam_from_world =
+        geometry::Sim3(covisible->cam_from_world() * world_from_cam) * candidate.cam_from_world;
+    std::vector<std::shared_ptr<map::MapPoint>> matched(covisible->features->size());
+    search_by_projection(*covisible, cam_from_world, candidate.loop_points, matched, 10.0);
+    const int matches = count_matched(matched);
+    spdlog::debug("loop candidate {}: {} matches in covisible keyframe {}", candidate.loop_keyframe->id, matches,
+                  covisible->id);
+    if (matches >= options_.min_total_matches) ++confirmed;
+  }
+  return confirmed;
+}
+
 bool LoopCloser::verify(const std::shared_ptr<map::KeyFrame>& keyframe,
-                        const std::vector<std::shared_ptr<map::KeyFrame>>& candidates, Candidate& accepted) {
+                        const std::vector<std::shared_ptr<map::KeyFrame>>& candidates, Candidate& accepted,
+                        int confirmations) {
   for (const auto& candidate : candidates) candidate->set_not_erase();
   bool found = false;
   for (const auto& candidate : candidates) {
@@ -262,7 +299,8 @@ bool LoopCloser::verify(const std::shared_ptr<map::KeyFrame>& keyframe,
     search_by_projection(*keyframe, c.cam_from_world, c.loop_points, c.matched, 10.0);
     c.matches = count_matched(c.matched);
     spdlog::debug("loop candidate {}: {} matches with the loop's neighbourhood", candidate->id, c.matches);
-    if (c.matches >= options_.min_total_matches) {
+    if (c.matches >= options_.min_total_matches &&
+        (confirmations == 0 || covisible_confirmations(*keyframe, c, confirmations) >= confirmations)) {
       accepted = std::move(c);
       found = true;
     }

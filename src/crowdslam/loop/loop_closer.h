@@ -2,10 +2,12 @@
 // Loop closing (ORB-SLAM2's LoopClosing, our way), in its own thread or inline (sequential mode).
 //
 // Per keyframe handed over by local mapping:
-//  1. detect:  consistent loop candidates from the keyframe database (LoopDetector);
+//  1. detect:  loop candidates from the keyframe database, those consistent over consecutive keyframes
+//              first (LoopDetector);
 //  2. verify:  BoW matches with each candidate -> Sim3 by RANSAC on 3D-3D matches (scale fixed for
 //              RGB-D / stereo) -> more matches through the Sim3 -> Sim3 refined -> matches of the loop's
-//              neighbourhood projected with the corrected pose; accepted with enough matches;
+//              neighbourhood projected with the corrected pose; accepted with enough matches. A candidate
+//              not yet consistent must also be confirmed by covisible keyframes (as ORB-SLAM3);
 //  3. correct: local mapping paused, a running global BA aborted; the keyframe's neighbourhood moved to
 //              its corrected pose (poses and points), loop points fused, essential graph optimised
 //              (spanning tree + strong covisibility + loop edges), loop edge added;
@@ -39,6 +41,13 @@ struct LoopCloserOptions {
   int min_bow_matches = 20;
   int min_sim3_inliers = 20;
   int min_total_matches = 40;            // after projecting the loop's neighbourhood
+  // A candidate not yet consistent over consecutive keyframes is still verified (at most
+  // `immediate_candidates` of them, best score first) and accepted when, besides the keyframe itself, this
+  // many of its covisible keyframes also match min_total_matches of the loop's points through the same
+  // correction (ORB-SLAM3's verification in covisible keyframes: a loop is closed when it is seen, not
+  // three keyframes later, which a crowd or the end of a sequence may never bring). 0 = off.
+  int covisible_confirmations = 1;
+  int immediate_candidates = 3;
   int essential_graph_min_weight = 100;  // covisibility edges of the essential graph
   int essential_graph_iterations = 20;
   bool global_ba = true;
@@ -61,6 +70,7 @@ struct LoopCloserStats {
   int keyframes_checked = 0;
   int candidates_consistent = 0;
   int candidates_rejected = 0;  // consistent, but geometric verification failed
+  int loops_confirmed_by_covisibles = 0;  // loops accepted before they were consistent
   std::vector<LoopEvent> loops;
   double detection_ms_total = 0;
   GlobalBaStats global_ba;
@@ -97,8 +107,14 @@ class LoopCloser {
 
   void run();
   void process_keyframe(const std::shared_ptr<map::KeyFrame>& keyframe, bool inline_mode);
+  // Geometric verification of `candidates` in turn; the first that passes is `accepted`. With
+  // `confirmations` > 0 a candidate must also be confirmed by that many covisible keyframes.
   bool verify(const std::shared_ptr<map::KeyFrame>& keyframe,
-              const std::vector<std::shared_ptr<map::KeyFrame>>& candidates, Candidate& accepted);
+              const std::vector<std::shared_ptr<map::KeyFrame>>& candidates, Candidate& accepted,
+              int confirmations = 0);
+  // Covisible keyframes of `keyframe` that match min_total_matches of the loop's points placed through
+  // the candidate's correction (stops counting at `needed`).
+  int covisible_confirmations(const map::KeyFrame& keyframe, const Candidate& candidate, int needed) const;
   void correct_loop(const std::shared_ptr<map::KeyFrame>& keyframe, const Candidate& loop);
 
   LoopCloserOptions options_;

@@ -45,8 +45,7 @@ std::vector<size_t> LoopDetector::update_consistency(const std::vector<std::set<
   return consistent;
 }
 
-std::vector<std::shared_ptr<map::KeyFrame>> LoopDetector::detect(const map::KeyFrame& keyframe,
-                                                                 const KeyframeDatabase& database) {
+LoopDetector::Detection LoopDetector::detect(const map::KeyFrame& keyframe, const KeyframeDatabase& database) {
   const double min_score = min_neighbour_score(keyframe);
   auto candidates = database.loop_candidates(keyframe, min_score);
   if (candidates.empty()) {
@@ -60,9 +59,16 @@ std::vector<std::shared_ptr<map::KeyFrame>> LoopDetector::detect(const map::KeyF
     for (const auto& kf : candidate->connected_keyframes()) group.insert(kf->id);
     groups.push_back(std::move(group));
   }
-  std::vector<std::shared_ptr<map::KeyFrame>> consistent;
-  for (size_t index : update_consistency(groups)) consistent.push_back(candidates[index]);
-  return consistent;
+  Detection detection;
+  std::vector<bool> is_consistent(candidates.size(), false);
+  for (size_t index : update_consistency(groups)) {
+    detection.consistent.push_back(candidates[index]);
+    is_consistent[index] = true;
+  }
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (!is_consistent[c]) detection.others.push_back(candidates[c]);
+  }
+  return detection;
 }
 
 }  // namespace crowdslam::loop

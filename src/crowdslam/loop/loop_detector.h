@@ -18,8 +18,12 @@ class LoopDetector {
  public:
   explicit LoopDetector(int consistency_threshold = 3) : consistency_threshold_(consistency_threshold) {}
 
-  // The consistent candidates for `keyframe` (empty: no loop). Updates the consistency groups.
-  std::vector<std::shared_ptr<map::KeyFrame>> detect(const map::KeyFrame& keyframe, const KeyframeDatabase& database);
+  struct Detection {
+    std::vector<std::shared_ptr<map::KeyFrame>> consistent;  // candidates consistent over consecutive keyframes
+    std::vector<std::shared_ptr<map::KeyFrame>> others;      // this keyframe's other candidates, best score first
+  };
+  // The candidates for `keyframe` (none consistent: no loop yet). Updates the consistency groups.
+  Detection detect(const map::KeyFrame& keyframe, const KeyframeDatabase& database);
 
   // Consistency bookkeeping on its own (for tests): candidates of the current keyframe and their groups
   // (each candidate with its covisible keyframes, as ids). Returns the indices of consistent candidates.

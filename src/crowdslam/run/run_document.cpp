@@ -411,6 +411,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
         {"keyframes_checked", loops.keyframes_checked},
         {"candidates_consistent", loops.candidates_consistent},
         {"candidates_rejected", loops.candidates_rejected},
+        {"loops_confirmed_by_covisibles", loops.loops_confirmed_by_covisibles},
         {"loops", events},
         {"detection_ms_mean", loops.detection_ms_total / std::max(1, loops.keyframes_checked)},
         {"global_ba_runs", loops.global_ba.runs},
