@@ -47,6 +47,11 @@ void TrackerOptions::check() const {
   if (!(reanchor_max_s >= 0)) throw InputError("tracker: reanchor_max_s must be >= 0");
   if (!(bridge_min_people_share >= 0 && bridge_min_people_share <= 1))
     throw InputError("tracker: bridge_min_people_share must be in [0, 1]");
+  if (bridge_resume_min_keypoints < 0) throw InputError("tracker: bridge_resume_min_keypoints must be >= 0");
+  if (!(bridge_gate_base_m >= 0 && bridge_gate_m_per_s >= 0 && bridge_gate_base_deg >= 0 &&
+        bridge_gate_deg_per_s >= 0)) {
+    throw InputError("tracker: bridge_gate_* must be >= 0");
+  }
   pose.check();
   dynamic.check();
   if (monocular) monocular_init.check();
@@ -202,6 +207,12 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       }
       dynamic_check_.set_suspended(false);
     }
+    if (ok && after_bridge && motion && !options_.monocular && !agrees_with_bridge(frame, *motion)) {
+      // Matched through its bag of words or relocalised far from where the bridge puts it moments after a
+      // short occlusion: the matches are on people the detector missed or on look-alike texture.
+      spdlog::debug("frame {}: {} pose rejected, too far from the bridged pose", frame.id, result.method);
+      ok = false;
+    }
     // While bridged, the keypoints in boxes are searched from where the bridge puts the frame: a person
     // close to a monocular camera hides the map outside the boxes, not behind them.
     if (!ok && after_bridge && motion && !bridged_guess) bridged_guess = motion->at(frame.timestamp_s);
@@ -239,8 +250,18 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     // People hide the view (bridge), or it has cleared after a bridge onto what the map does not hold: with
     // depth, mapping goes on from the motion model's pose (the frame is a keyframe, still reported bridged).
     const bool hidden = people_share >= options_.bridge_min_people_share;
-    const bool resumes = !ok && !hidden && after_bridge && !options_.monocular && !localization_only_ &&
-                         map_points_in_view < static_cast<size_t>(options_.bridge_resume_max_map_points);
+    bool resumes = false;
+    if (!ok && after_bridge && motion && !options_.monocular && !localization_only_) {
+      const auto max_points = static_cast<size_t>(options_.bridge_resume_max_map_points);
+      if (!hidden) {
+        resumes = map_points_in_view < max_points;
+      } else if (options_.bridge_resume_min_keypoints > 0 &&
+                 depth_keypoints_outside_boxes(frame) >= static_cast<size_t>(options_.bridge_resume_min_keypoints)) {
+        map::Frame at_bridge = frame;
+        at_bridge.cam_from_world = motion->at(frame.timestamp_s);
+        resumes = map_points_near_keypoints(at_bridge) < max_points;
+      }
+    }
     const bool occluded =
         !ok && (hidden || resumes) && (was_tracking || after_bridge) && bridge(frame, start_motion());
     if (occluded && resumes) {

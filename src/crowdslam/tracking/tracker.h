@@ -115,6 +115,19 @@ struct TrackerOptions {
   // the frame is lost and relocalised instead: the map is there, and a keyframe at a drifted pose would
   // contradict it.
   int bridge_resume_max_map_points = 100;
+  // ... and while people still cover at least bridge_min_people_share of the keypoints, when the frame
+  // has at least this many keypoints with depth outside the person boxes: then the map points in view are
+  // counted only where the frame has keypoints (a person in front hides the others), so a strip of
+  // background between people that the map never saw carries tracking on (0 = only when the view clears).
+  int bridge_resume_min_keypoints = 150;
+  // With depth, a frame tracked after bridged frames is rejected (still bridged) when its pose differs
+  // from the bridge's by more than base + rate x the time since the bridge's anchor: the bridge drifts a
+  // few centimetres in a second, a pose from matches on a missed person or on look-alike texture by
+  // metres (0 base = no check).
+  double bridge_gate_base_m = 0.1;
+  double bridge_gate_m_per_s = 0.3;
+  double bridge_gate_base_deg = 10.0;
+  double bridge_gate_deg_per_s = 30.0;
   // A pose predicted without a measurement (a frame's after bridged frames) is first
   // refined on the local map searched in windows `prediction_radius_factor` times ORB-SLAM's base window
   // (wider than local_map_radius_factor), when at least `prediction_min_inliers` of those matches agree;
@@ -286,6 +299,9 @@ class Tracker {
   // Whether `frame` can be bridged (TrackerOptions::bridge_max_s): within bridge_max_s of the last tracked
   // frame, with a motion to follow. Sets the frame's pose from it (no matches) if so.
   bool bridge(map::Frame& frame, const std::optional<BridgeMotion>& motion) const;
+  // With depth: whether the frame's pose, found after bridged frames, is within what the bridge's motion
+  // can have drifted since its anchor (TrackerOptions::bridge_gate_*).
+  [[nodiscard]] bool agrees_with_bridge(const map::Frame& frame, const BridgeMotion& motion) const;
   // On from the last frame at `velocity` (its velocity when the frame came).
   [[nodiscard]] std::optional<BridgeMotion> last_frame_motion(const map::Frame& frame,
                                                               const std::optional<geometry::SE3>& velocity) const;
@@ -302,6 +318,10 @@ class Tracker {
   // map's points matched in wide windows. The frame's matches are left empty. False (pose unchanged) when
   // too few agree.
   bool refine_predicted_pose(map::Frame& frame) const;
+  // Local map points that `frame` (at its pose) would see where it has a keypoint within a search window.
+  [[nodiscard]] size_t map_points_near_keypoints(const map::Frame& frame) const;
+  // Keypoints with depth outside the person boxes.
+  [[nodiscard]] static size_t depth_keypoints_outside_boxes(const map::Frame& frame);
   // The motion bridge_motion() would follow, also when the bridge is off (monocular re-anchoring).
   [[nodiscard]] std::optional<BridgeMotion> recent_motion(const map::Frame& frame,
                                                           const std::optional<geometry::SE3>& velocity) const;

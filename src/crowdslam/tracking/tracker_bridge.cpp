@@ -1,5 +1,6 @@
 // The occlusion bridge (TrackerOptions::bridge_max_s, docs/CROWDS.md#total-occlusion): the motion that
 // frames people hide entirely follow until the view clears.
+#include <algorithm>
 #include <cmath>
 
 #include "crowdslam/tracking/localize_frames.h"
@@ -106,6 +107,49 @@ bool Tracker::refine_predicted_pose(map::Frame& frame) const {
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   std::fill(frame.outliers.begin(), frame.outliers.end(), false);
   return true;
+}
+
+bool Tracker::agrees_with_bridge(const map::Frame& frame, const BridgeMotion& motion) const {
+  if (!(options_.bridge_gate_base_m > 0) || !frame.cam_from_world) return true;
+  const double elapsed_s = std::max(0.0, frame.timestamp_s - motion.anchor_s);
+  const geometry::SE3 predicted = motion.at(frame.timestamp_s);
+  // Camera centres and viewing rotations compared (cam_from_world: the centre is -R^T t).
+  const geometry::SE3 world_from_cam = frame.cam_from_world->inverse();
+  const geometry::SE3 world_from_predicted = predicted.inverse();
+  const double distance_m = (world_from_cam.translation() - world_from_predicted.translation()).norm();
+  const double angle_deg =
+      geometry::rotation_angle(world_from_predicted.rotation_matrix().transpose() * world_from_cam.rotation_matrix()) *
+      180.0 / M_PI;
+  return distance_m <= options_.bridge_gate_base_m + options_.bridge_gate_m_per_s * elapsed_s &&
+         angle_deg <= options_.bridge_gate_base_deg + options_.bridge_gate_deg_per_s * elapsed_s;
+}
+
+size_t Tracker::map_points_near_keypoints(const map::Frame& frame) const {
+  if (!frame.cam_from_world) return 0;
+  const auto& f = *frame.features;
+  size_t near = 0;
+  for (const auto& p : local_points_) {
+    if (p->is_bad()) continue;
+    const auto projection = frame.project(*p, 0.5);
+    if (!projection) continue;
+    // ORB-SLAM's base window (4 px at level 0) as widened for tracking the local map.
+    const double radius = 4.0 * options_.local_map_radius_factor * frame.levels->scale[projection->predicted_level];
+    if (!f.grid.features_in_area(f.keys_un, static_cast<float>(projection->u), static_cast<float>(projection->v),
+                                 static_cast<float>(radius))
+             .empty()) {
+      ++near;
+    }
+  }
+  return near;
+}
+
+size_t Tracker::depth_keypoints_outside_boxes(const map::Frame& frame) {
+  const auto& f = *frame.features;
+  size_t n = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (f.depth_m[i] > 0 && !frame.in_box[i] && !frame.dynamic[i]) ++n;
+  }
+  return n;
 }
 
 }  // namespace crowdslam::tracking
