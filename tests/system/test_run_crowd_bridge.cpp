@@ -57,3 +57,51 @@ TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPose
   EXPECT_GE(summary["tracked_percent"].get<double>(), 97.0);
   EXPECT_LT(summary["ate_rmse_m"].get<double>(), 0.03);
 }
+
+// RGB-D blackout with the default detector: people fill the view from half a metre, cut by the image's
+// edges, and the detector misses them in most of those frames, so the people filter takes nothing and
+// the frames were lost, and a second later a new map started. With depth, a frame whose keypoints are
+// mostly nearer than half the scene's depth before is hidden too (TrackerOptions::bridge_near_depth_ratio):
+// bridged, never mapped from, and the run keeps one map.
+TEST(RunCrowdBridge, RgbdBlackoutTheDetectorMissesIsBridgedByDepthInOneMap) {
+  if (!fs::exists(crowdslam::test::shared_dir() / "models" / "yolo-fastest-1.1")) {
+    GTEST_SKIP() << "shared detector models missing";
+  }
+  if (!fs::exists(crowdslam::synth::default_sprite_dir() / "sprites.json")) {
+    GTEST_SKIP() << "person sprites missing (scripts/build_people_sprites.sh)";
+  }
+  crowdslam::test::TempDir tmp;
+  const auto seq = tmp / "blackout";
+  const auto synth = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "300", "--seed", "5", "--people",
+                              "8", "--crowd", "blackout"});
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  const auto planned = nlohmann::json::parse(crowdslam::test::read_text(seq / "synth.json"))["blackout_frames"];
+  const int first = planned[0].get<int>();
+  const int last = planned[1].get<int>();
+  const auto out = tmp / "run";
+  const auto run = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sequential",
+                            "--allow-untracked"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  EXPECT_EQ(doc["summary"]["map_resets"].get<int>(), 0);
+  int covered = 0;
+  int covered_bridged = 0;
+  int undetected_bridged = 0;  // bridged although the filter took less than half the keypoints
+  for (const auto& f : doc["frames"]) {
+    const int index = f["index"].get<int>();
+    if (index < first || index > last) continue;
+    ++covered;
+    if (f["state"] != "bridged") continue;
+    ++covered_bridged;
+    if (f["keypoints"].get<double>() > 0.5 * f["keypoints_before_filter"].get<double>()) ++undetected_bridged;
+  }
+  const auto& report = doc["accuracy"]["bridged"];
+  std::printf("%d of %d covered frames bridged (%d the filter took less than half of), tracked %.1f %%, "
+              "after/before %.2f\n",
+              covered_bridged, covered, undetected_bridged, doc["summary"]["tracked_percent"].get<double>(),
+              report["after_over_before_max"].get<double>());
+  EXPECT_GE(covered_bridged, covered * 9 / 10);
+  EXPECT_GE(undetected_bridged, 1);
+  // When the view clears, the pose is back within twice the error it had before the crowd covered it.
+  EXPECT_LE(report["after_over_before_max"].get<double>(), 2.0);
+}

@@ -47,6 +47,8 @@ void TrackerOptions::check() const {
   if (!(reanchor_max_s >= 0)) throw InputError("tracker: reanchor_max_s must be >= 0");
   if (!(bridge_min_people_share >= 0 && bridge_min_people_share <= 1))
     throw InputError("tracker: bridge_min_people_share must be in [0, 1]");
+  if (!(bridge_near_depth_ratio >= 0 && bridge_near_depth_ratio < 1))
+    throw InputError("tracker: bridge_near_depth_ratio must be in [0, 1)");
   if (bridge_resume_min_keypoints < 0) throw InputError("tracker: bridge_resume_min_keypoints must be >= 0");
   if (!(bridge_gate_base_m >= 0 && bridge_gate_m_per_s >= 0 && bridge_gate_base_deg >= 0 &&
         bridge_gate_deg_per_s >= 0)) {
@@ -76,6 +78,7 @@ void Tracker::reset() {
   reanchor_.reset();
   frames_since_loss_.clear();
   recent_poses_.clear();
+  scene_depth_m_ = 0;
   next_frame_wait_ = NextFrameWait::kNone;
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
@@ -249,14 +252,15 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     }
     // People hide the view (bridge), or it has cleared after a bridge onto what the map does not hold: with
     // depth, mapping goes on from the motion model's pose (the frame is a keyframe, still reported bridged).
-    const bool hidden = people_share >= options_.bridge_min_people_share;
+    const bool hidden = people_share >= options_.bridge_min_people_share ||
+                        (!ok && !options_.monocular && near_occluder_share(frame) >= options_.bridge_min_people_share);
     bool resumes = false;
     if (!ok && after_bridge && motion && !options_.monocular && !localization_only_) {
       const auto max_points = static_cast<size_t>(options_.bridge_resume_max_map_points);
       if (!hidden) {
         resumes = map_points_in_view < max_points;
       } else if (options_.bridge_resume_min_keypoints > 0 &&
-                 depth_keypoints_outside_boxes(frame) >= static_cast<size_t>(options_.bridge_resume_min_keypoints)) {
+                 background_keypoints(frame) >= static_cast<size_t>(options_.bridge_resume_min_keypoints)) {
         map::Frame at_bridge = frame;
         at_bridge.cam_from_world = motion->at(frame.timestamp_s);
         resumes = map_points_near_keypoints(at_bridge) < max_points;
@@ -317,6 +321,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       bridge_recent_motion_.reset();
       if (!resumed) {
         recent_poses_.push_back({frame.timestamp_s, *frame.cam_from_world, inliers_in_local_map_});
+        if (!options_.monocular) scene_depth_m_ = inlier_median_depth(frame);
         while (recent_poses_.size() > 30) recent_poses_.pop_front();
       } else {
         recent_poses_.clear();

@@ -106,6 +106,11 @@ struct TrackerOptions {
   // (0 = off: such frames are lost).
   double bridge_max_s = 3.0;
   double bridge_min_people_share = 0.5;
+  // With depth, a frame is hidden too when at least bridge_min_people_share of its keypoints with depth
+  // (after the filter) are nearer than this fraction of the scene's median depth at the last tracked
+  // frame: something close covers the view, a person the detector missed (filling the view from half a
+  // metre, cut by the image's edges) or anything else (0 = off).
+  double bridge_near_depth_ratio = 0.5;
   // The bridge moves on from the last frame tracked with at least this many local-map inliers, at the
   // mean velocity of such frames over the half second before it: as people close in, the last few frames
   // are tracked on little and their poses (and the frame-to-frame velocity) are the least trustworthy.
@@ -116,7 +121,7 @@ struct TrackerOptions {
   // contradict it.
   int bridge_resume_max_map_points = 100;
   // ... and while people still cover at least bridge_min_people_share of the keypoints, when the frame
-  // has at least this many keypoints with depth outside the person boxes: then the map points in view are
+  // has at least this many keypoints with depth outside the person boxes (and not near, below): then the map points in view are
   // counted only where the frame has keypoints (a person in front hides the others), so a strip of
   // background between people that the map never saw carries tracking on (0 = only when the view clears).
   int bridge_resume_min_keypoints = 150;
@@ -320,8 +325,14 @@ class Tracker {
   bool refine_predicted_pose(map::Frame& frame) const;
   // Local map points that `frame` (at its pose) would see where it has a keypoint within a search window.
   [[nodiscard]] size_t map_points_near_keypoints(const map::Frame& frame) const;
-  // Keypoints with depth outside the person boxes.
-  [[nodiscard]] static size_t depth_keypoints_outside_boxes(const map::Frame& frame);
+  // Keypoints with depth outside the person boxes and not nearer than the near-occluder depth
+  // (bridge_near_depth_ratio x the scene's depth).
+  [[nodiscard]] size_t background_keypoints(const map::Frame& frame) const;
+  // Median camera depth of the frame's inlier map points (0 without any).
+  [[nodiscard]] static double inlier_median_depth(const map::Frame& frame);
+  // Share of the frame's keypoints with depth that are nearer than bridge_near_depth_ratio x the scene's
+  // depth at the last tracked frame (0 when either is unknown).
+  [[nodiscard]] double near_occluder_share(const map::Frame& frame) const;
   // The motion bridge_motion() would follow, also when the bridge is off (monocular re-anchoring).
   [[nodiscard]] std::optional<BridgeMotion> recent_motion(const map::Frame& frame,
                                                           const std::optional<geometry::SE3>& velocity) const;
@@ -379,6 +390,7 @@ class Tracker {
     int inliers = 0;
   };
   std::deque<RecentPose> recent_poses_;  // the last tracked frames (bridge_motion)
+  double scene_depth_m_ = 0;  // median depth of the last tracked frame's inliers (0: unknown)
   std::optional<double> last_bridged_s_;          // timestamp of the last bridged frame (the lost clock)
   int inliers_in_local_map_ = 0;
   size_t projected_local_points_ = 0;  // local map points in view in the last track_local_map

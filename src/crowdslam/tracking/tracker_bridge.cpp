@@ -2,6 +2,7 @@
 // frames people hide entirely follow until the view clears.
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "crowdslam/tracking/localize_frames.h"
 
@@ -143,11 +144,42 @@ size_t Tracker::map_points_near_keypoints(const map::Frame& frame) const {
   return near;
 }
 
-size_t Tracker::depth_keypoints_outside_boxes(const map::Frame& frame) {
+double Tracker::inlier_median_depth(const map::Frame& frame) {
+  if (!frame.cam_from_world) return 0;
+  std::vector<double> depths;
+  depths.reserve(frame.map_points.size());
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || frame.outliers[i] || p->is_bad()) continue;
+    const double z = (*frame.cam_from_world * p->world()).z();
+    if (z > 0) depths.push_back(z);
+  }
+  if (depths.empty()) return 0;
+  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  return *middle;
+}
+
+double Tracker::near_occluder_share(const map::Frame& frame) const {
+  if (!(options_.bridge_near_depth_ratio > 0) || !(scene_depth_m_ > 0)) return 0;
+  const double near = options_.bridge_near_depth_ratio * scene_depth_m_;
+  const auto& f = *frame.features;
+  size_t with_depth = 0;
+  size_t nearer = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (!(f.depth_m[i] > 0)) continue;
+    ++with_depth;
+    if (f.depth_m[i] < near) ++nearer;
+  }
+  return with_depth == 0 ? 0.0 : static_cast<double>(nearer) / static_cast<double>(with_depth);
+}
+
+size_t Tracker::background_keypoints(const map::Frame& frame) const {
+  const double near = options_.bridge_near_depth_ratio * scene_depth_m_;
   const auto& f = *frame.features;
   size_t n = 0;
   for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth_m[i] > 0 && !frame.in_box[i] && !frame.dynamic[i]) ++n;
+    if (f.depth_m[i] > 0 && f.depth_m[i] >= near && !frame.in_box[i] && !frame.dynamic[i]) ++n;
   }
   return n;
 }
