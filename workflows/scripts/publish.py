@@ -10,7 +10,7 @@ MATRIX.detect.json), replacing the one stored before. Then docs/RESULTS.md is wr
 table (with the machine, dates and command of each) and the README's table between
 <!-- results:begin --> and <!-- results:end --> from the rows published.yaml names.
 docs/results/build_times.json comes from scripts/measure_build_times.py. The crowd matrix named by
-published.yaml's `crowds:` is also shown in docs/CROWDS.md between <!-- crowds:begin --> and
+published.yaml's `crowds:` is also shown in docs/CROWD_TESTBED.md between <!-- crowds:begin --> and
 <!-- crowds:end -->, one row per crowd case (profile, people, sensor, detector) beside its empty room,
 and the detection matrix named by `detection:` in docs/DETECTION.md between <!-- detection:begin --> and
 <!-- detection:end -->, one row per detector configuration.
@@ -136,7 +136,7 @@ def crowd_case(dataset, options):
 
 
 def crowds_table(table):
-    """The crowd matrix in docs/CROWDS.md: a row per crowd case, with the empty room's ATE beside it."""
+    """The crowd matrix in docs/CROWD_TESTBED.md: a row per crowd case, with the empty room's ATE beside it."""
     m, cases = table["matrix"], table["cases"]
     lines = [f"Medians of {m['runs']} {'threaded' if m['mode'] == 'timing' else 'sequential'} runs per case; "
              f"measured {table['provenance']['last']} on {'; '.join(table['provenance']['machines'])}, "
@@ -236,13 +236,13 @@ def main():
     write_readme(readme_table(published["readme"]))
     crowds = published.get("crowds") and stored(published["crowds"] + ".json")
     if crowds:
-        replace_block(os.path.join(REPO, "docs", "CROWDS.md"), CROWDS_BEGIN, CROWDS_END, crowds_table(crowds))
+        replace_block(os.path.join(REPO, "docs", "CROWD_TESTBED.md"), CROWDS_BEGIN, CROWDS_END, crowds_table(crowds))
     detection = published.get("detection") and stored(published["detection"] + ".detect.json")
     if detection:
         replace_block(os.path.join(REPO, "docs", "DETECTION.md"), DETECTION_BEGIN, DETECTION_END,
                       detection_table(detection))
     print("publish: wrote docs/RESULTS.md, the README's results table"
-          + (", docs/CROWDS.md's crowd table" if crowds else "")
+          + (", docs/CROWD_TESTBED.md's crowd table" if crowds else "")
           + (", docs/DETECTION.md's accuracy table" if detection else ""), file=sys.stderr)
 
 
