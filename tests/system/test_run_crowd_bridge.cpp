@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "crowdslam/synth/sprites.h"
 #include "test_support.h"
@@ -14,13 +15,21 @@
 namespace fs = std::filesystem;
 using crowdslam::test::run_cli;
 
-TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPoseAndKeepsOneMap) {
-  if (!fs::exists(crowdslam::test::shared_dir() / "models" / "yolo-fastest-1.1")) {
-    GTEST_SKIP() << "shared detector models missing";
-  }
+namespace {
+// Why the crowd cannot be rendered with people a detector sees, or run with the default detector ("" = it
+// can): the shared models and the person sprites the setup cuts out of the MOT sequences.
+std::string missing_inputs() {
+  if (!fs::exists(crowdslam::test::shared_dir() / "models" / "yolo-fastest-1.1")) return "shared detector models missing";
   if (!fs::exists(crowdslam::synth::default_sprite_dir() / "sprites.json")) {
-    GTEST_SKIP() << "person sprites missing (scripts/build_people_sprites.sh)";
+    return "person sprites missing (scripts/build_people_sprites.sh)";
   }
+  return "";
+}
+}  // namespace
+
+
+TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPoseAndKeepsOneMap) {
+  if (const std::string why = missing_inputs(); !why.empty()) GTEST_SKIP() << why;
   crowdslam::test::TempDir tmp;
   const auto seq = tmp / "crowd";
   const auto synth = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "300", "--seed", "5", "--people",
@@ -64,12 +73,7 @@ TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPose
 // mostly nearer than half the scene's depth before is hidden too (TrackerOptions::bridge_near_depth_ratio):
 // bridged, never mapped from, and the run keeps one map.
 TEST(RunCrowdBridge, RgbdBlackoutTheDetectorMissesIsBridgedByDepthInOneMap) {
-  if (!fs::exists(crowdslam::test::shared_dir() / "models" / "yolo-fastest-1.1")) {
-    GTEST_SKIP() << "shared detector models missing";
-  }
-  if (!fs::exists(crowdslam::synth::default_sprite_dir() / "sprites.json")) {
-    GTEST_SKIP() << "person sprites missing (scripts/build_people_sprites.sh)";
-  }
+  if (const std::string why = missing_inputs(); !why.empty()) GTEST_SKIP() << why;
   crowdslam::test::TempDir tmp;
   const auto seq = tmp / "blackout";
   const auto synth = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "300", "--seed", "5", "--people",
