@@ -144,6 +144,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.tracking.odometry_bridge_min_inliers = 0;
   s.tracking.reanchor_max_s = 1.5;
   s.tracking.odometry_sigma_deg = 0.1 + 0.2;
+  s.tracking.keyframe_reference_ratio = 0.75;
   s.ground.enabled = true;
   s.ground.keyframe_sigma = 0.1 + 0.2;
   TempDir dir;
@@ -158,6 +159,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   EXPECT_EQ(back.tracking.odometry_bridge_min_inliers, 0);
   EXPECT_EQ(back.tracking.reanchor_max_s, 1.5);
   EXPECT_EQ(back.tracking.odometry_sigma_deg, 0.1 + 0.2);
+  EXPECT_EQ(back.tracking.keyframe_reference_ratio, 0.75);
   EXPECT_TRUE(back.ground.enabled);
   EXPECT_EQ(back.ground.keyframe_sigma, 0.1 + 0.2);
   // A monocular settings object without rectification also survives.
@@ -310,6 +312,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "Tracking.odometry_bridge_min_inliers: expected an integer"},
         BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.odometry_sigma_deg: -0.3",
                  "Tracking.odometry_sigma_deg: must be in [0, 90] degrees (0 = off)"},
+        BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.keyframe_reference_ratio: 1.5",
+                 "Tracking.keyframe_reference_ratio: must be in (0, 1]"},
         BadValue{"Detector.nms", "Detector.nms: 0.1\nGround.keyframe_sigma: 0",
                  "Ground.keyframe_sigma: must be in (0, 1] (relative to the camera's height)"},
         BadValue{"Detector.nms", "Detector.nms: 0.1\nGround.enabled: 2", "Ground.enabled: expected 0 or 1"},

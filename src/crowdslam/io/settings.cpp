@@ -110,6 +110,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("Tracking.bridge_max_s"), s.tracking.bridge_max_s);
   set_if(r.real("Tracking.reanchor_max_s"), s.tracking.reanchor_max_s);
   set_if(r.real("Tracking.odometry_sigma_deg"), s.tracking.odometry_sigma_deg);
+  set_if(r.real("Tracking.keyframe_reference_ratio"), s.tracking.keyframe_reference_ratio);
   set_if(r.real("Tracking.bridge_min_people_share"), s.tracking.bridge_min_people_share);
   set_if(r.flag("Ground.enabled"), s.ground.enabled);
   set_if(r.real("Ground.keyframe_sigma"), s.ground.keyframe_sigma);
@@ -213,7 +214,8 @@ bool operator==(const Settings& a, const Settings& b) {
                         a.tracking.bridge_max_s == b.tracking.bridge_max_s &&
                         a.tracking.bridge_min_people_share == b.tracking.bridge_min_people_share &&
                         a.tracking.reanchor_max_s == b.tracking.reanchor_max_s &&
-                        a.tracking.odometry_sigma_deg == b.tracking.odometry_sigma_deg;
+                        a.tracking.odometry_sigma_deg == b.tracking.odometry_sigma_deg &&
+                        a.tracking.keyframe_reference_ratio == b.tracking.keyframe_reference_ratio;
   const bool ground = a.ground.enabled == b.ground.enabled && a.ground.keyframe_sigma == b.ground.keyframe_sigma;
   return camera && orb && detector && people && geometry && tracking && ground && budget && a.th_depth == b.th_depth &&
          a.depth_map_factor == b.depth_map_factor && a.has_depth_map_factor == b.has_depth_map_factor &&

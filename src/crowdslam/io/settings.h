@@ -138,6 +138,10 @@ struct TrackingSettings {
   // relative to the keyframe before, with this rotation sigma in degrees (translation: the angle times
   // the keyframe's median depth); 0 = off, as ORB-SLAM.
   double odometry_sigma_deg = 0.3;
+  // RGB-D / stereo: a keyframe is due when the frame tracks fewer than this share of its reference
+  // keyframe's points (ORB-SLAM2: 0.75). Fewer keyframes cost less CPU; more measured better in crowds
+  // (docs/PROFILE.md). Monocular keeps ORB-SLAM2's 0.9.
+  double keyframe_reference_ratio = 0.9;
 };
 
 // A monocular camera that rides at a constant height above planar ground (on a car or a ground robot):

@@ -234,6 +234,9 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(std::isfinite(s.tracking.odometry_sigma_deg) && s.tracking.odometry_sigma_deg >= 0 &&
                 s.tracking.odometry_sigma_deg <= 90,
             "Tracking.odometry_sigma_deg", "in [0, 90] degrees (0 = off)", s.tracking.odometry_sigma_deg);
+  c.require(std::isfinite(s.tracking.keyframe_reference_ratio) && s.tracking.keyframe_reference_ratio > 0 &&
+                s.tracking.keyframe_reference_ratio <= 1,
+            "Tracking.keyframe_reference_ratio", "in (0, 1]", s.tracking.keyframe_reference_ratio);
   c.require(std::isfinite(s.tracking.bridge_min_people_share) && s.tracking.bridge_min_people_share >= 0 &&
                 s.tracking.bridge_min_people_share <= 1,
             "Tracking.bridge_min_people_share", "in [0, 1]", s.tracking.bridge_min_people_share);

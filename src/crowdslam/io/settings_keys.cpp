@@ -84,6 +84,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "Tracking.bridge_min_people_share",
                                   "Tracking.reanchor_max_s",
                                   "Tracking.odometry_sigma_deg",
+                                  "Tracking.keyframe_reference_ratio",
                                   "Ground.enabled",
                                   "Ground.keyframe_sigma",
                                   "FeatureBudget.enabled",

@@ -128,7 +128,8 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nTracking.bridge_max_s: " << real_text(s.tracking.bridge_max_s)
       << "\nTracking.bridge_min_people_share: " << real_text(s.tracking.bridge_min_people_share)
       << "\nTracking.reanchor_max_s: " << real_text(s.tracking.reanchor_max_s)
-      << "\nTracking.odometry_sigma_deg: " << real_text(s.tracking.odometry_sigma_deg) << "\n\n";
+      << "\nTracking.odometry_sigma_deg: " << real_text(s.tracking.odometry_sigma_deg)
+      << "\nTracking.keyframe_reference_ratio: " << real_text(s.tracking.keyframe_reference_ratio) << "\n\n";
   out << "# A monocular camera at a constant height above the ground (a car's)\nGround.enabled: "
       << (s.ground.enabled ? 1 : 0) << "\nGround.keyframe_sigma: " << real_text(s.ground.keyframe_sigma) << "\n\n";
   const auto& b = s.feature_budget;

@@ -101,6 +101,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracker_options.odometry_bridge_min_inliers = settings.tracking.odometry_bridge_min_inliers;
   tracker_options.bridge_max_s = settings.tracking.bridge_max_s;
   tracker_options.reanchor_max_s = settings.tracking.reanchor_max_s;
+  tracker_options.keyframe_reference_ratio = settings.tracking.keyframe_reference_ratio;
   tracker_options.bridge_min_people_share = settings.tracking.bridge_min_people_share;
   const io::GeometrySettings& g = settings.geometry;
   tracker_options.dynamic.enabled = g.dynamic_check;
