@@ -48,6 +48,26 @@ def test_dry_run(tmp_path, matrix):
     assert "Job stats" in r.stdout + r.stderr
 
 
+PARTS = sorted(glob.glob(os.path.join(SOURCE, "workflows", "matrices", "parts", "*.yaml")))
+
+
+@pytest.mark.parametrize("part", PARTS, ids=[os.path.basename(p)[:-5] for p in PARTS])
+def test_a_part_selects_crowd_cases_with_their_empty_rooms(tmp_path, part):
+    # A part (parts/*.yaml) replaces its base matrix's `cases:`; every crowd case it selects must have its
+    # empty room in the selection too, or the table has no "ATE / empty" for it.
+    import matrix as mx
+    import yaml
+    base = os.path.join(SOURCE, "workflows", "matrices", "synthetic_crowd.yaml")
+    assert "synthetic_crowd.yaml" in open(part).read(), "a part names its base matrix"
+    config = yaml.safe_load(open(base))
+    config.update(yaml.safe_load(open(part)))
+    m = mx.Matrix(config, repo=SOURCE, results=str(tmp_path))
+    assert m.cases, f"{part} selects no case"
+    for name, case in m.cases.items():
+        if m.datasets[case["dataset"]].get("baseline"):  # a crowd case (the empty rooms have none)
+            assert m.baseline(name), f"{name}: its empty room is not selected"
+
+
 def test_a_list_of_grids_expands_to_the_union_of_their_products(tmp_path):
     import matrix as mx
     config = {"matrix": "grids", "datasets": {"{crowd}_{people}": {
