@@ -1,3 +1,4 @@
+#include <array>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -195,6 +196,44 @@ TEST(MapPoint, DistinctiveDescriptorIsTheMedoid) {
   EXPECT_EQ(d[0], 0xFF);
   EXPECT_EQ(d[1], 0x00);
   EXPECT_EQ(d[2], 0x00);
+}
+
+TEST(MapPoint, DistinctiveDescriptorFollowsItsObservations) {
+  // Computed once per set of observations (MapPoint::compute_distinctive_descriptor skips a repeat):
+  // adding or erasing an observation, or setting the descriptor from outside, makes the next call count.
+  TestMap t;
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  for (int i = 0; i < 4; ++i) kfs.push_back(t.add_keyframe());
+  std::vector<std::shared_ptr<FrameFeatures>> f;
+  for (auto& kf : kfs) {
+    f.push_back(std::const_pointer_cast<FrameFeatures>(kf->features));
+    f.back()->descriptors.row(5).setTo(0);
+  }
+  // a = 0, b = all ones, c = all ones but 4 bits, d = 0.
+  f[1]->descriptors.row(5).setTo(0xFF);
+  f[2]->descriptors.row(5).setTo(0xFF);
+  f[2]->descriptors.at<uint8_t>(5, 0) = 0x0F;
+  const auto [a, b, c, d] = std::tie(kfs[0], kfs[1], kfs[2], kfs[3]);
+  auto p = t.add_point({a, b}, 5);
+  p->compute_distinctive_descriptor();
+  EXPECT_EQ(p->descriptor()[1], 0x00);  // a and b tie: the first, a
+  p->add_observation(c, 5);
+  p->compute_distinctive_descriptor();
+  EXPECT_EQ(p->descriptor()[1], 0xFF);  // b: median distance 4 (to c)
+  EXPECT_EQ(p->descriptor()[0], 0xFF);
+  // Set from outside, then computed again from the same observations: the medoid comes back.
+  const std::array<uint8_t, 32> zeros{};
+  p->set_descriptor(zeros.data());
+  EXPECT_EQ(p->descriptor()[1], 0x00);
+  p->compute_distinctive_descriptor();
+  EXPECT_EQ(p->descriptor()[1], 0xFF);
+  p->add_observation(d, 5);
+  p->compute_distinctive_descriptor();
+  EXPECT_EQ(p->descriptor()[1], 0x00);  // a: median distance 0 (to d)
+  p->erase_observation(d->id);
+  ASSERT_FALSE(p->is_bad());
+  p->compute_distinctive_descriptor();
+  EXPECT_EQ(p->descriptor()[1], 0xFF);  // b again
 }
 
 TEST(MapPoint, NormalAndScaleRange) {

@@ -96,6 +96,7 @@ void MapPoint::add_observation(const std::shared_ptr<KeyFrame>& keyframe, size_t
   auto it = lower_bound_id(observations_.begin(), observations_.end(), keyframe->id);
   if (it != observations_.end() && it->first == keyframe->id) return;
   observations_.insert(it, {keyframe->id, Observation{keyframe, index}});
+  descriptor_stale_ = true;
   num_observations_ += keyframe->features->has_right(index) ? 2 : 1;
 }
 
@@ -109,6 +110,7 @@ void MapPoint::erase_observation(uint64_t keyframe_id) {
     const bool stereo = kf && kf->features->has_right(it->second.index);
     num_observations_ -= stereo ? 2 : 1;
     observations_.erase(it);
+    descriptor_stale_ = true;
     auto ref = reference_keyframe_.lock();
     if ((!ref || ref->id == keyframe_id) && !observations_.empty()) {
       reference_keyframe_ = observations_.begin()->second.keyframe;
@@ -156,6 +158,8 @@ void MapPoint::compute_distinctive_descriptor() {
     // Under the lock without copying the observations: KeyFrame::is_bad() takes no lock and a keyframe's
     // features never change, so no other mutex is taken here.
     std::lock_guard lock(features_mutex_);
+    if (!descriptor_stale_) return;  // computed from these observations already
+    descriptor_stale_ = false;       // set again by any change from here on
     descriptors.reserve(observations_.size());
     keep_alive.reserve(observations_.size());
     for (const auto& [kf_id, obs] : observations_) {
@@ -197,6 +201,7 @@ void MapPoint::compute_distinctive_descriptor() {
 void MapPoint::set_descriptor(const uint8_t* descriptor) {
   std::lock_guard lock(features_mutex_);
   std::copy(descriptor, descriptor + 32, descriptor_.begin());
+  descriptor_stale_ = true;
 }
 
 void MapPoint::update_normal_and_depth() {

@@ -143,6 +143,10 @@ class MapPoint {
   int num_observations_ = 0;
   std::weak_ptr<KeyFrame> reference_keyframe_;
   Descriptor descriptor_{};
+  // The observations changed since descriptor_ was last computed from them (or it was set from outside):
+  // compute_distinctive_descriptor() has work to do. Local mapping asks for it after each step that may
+  // have added an observation, most often with nothing changed.
+  bool descriptor_stale_ = true;
   // Read on every tracked frame for every local point: atomics, not the mutex (bad_ is written under
   // the mutex, with the observations it goes with).
   std::atomic<int> visible_{1};
