@@ -173,18 +173,25 @@ TEST(KeyFrame, FoundMapPointsCountsFramesNotKeyframes) {
   EXPECT_EQ(b->found_map_points(2), 0);
 }
 
+// Four keyframes whose keypoint 5 has an all-zero descriptor, and their features to write it through.
+struct DescriptorKeyframes {
+  std::vector<std::shared_ptr<KeyFrame>> kfs;
+  std::vector<std::shared_ptr<FrameFeatures>> f;
+  explicit DescriptorKeyframes(TestMap& t) {
+    for (int i = 0; i < 4; ++i) {
+      kfs.push_back(t.add_keyframe());
+      f.push_back(std::const_pointer_cast<FrameFeatures>(kfs.back()->features));
+      f.back()->descriptors.row(5).setTo(0);
+    }
+  }
+};
+
 TEST(MapPoint, DistinctiveDescriptorIsTheMedoid) {
   TestMap t;
-  std::vector<std::shared_ptr<KeyFrame>> kfs;
-  for (int i = 0; i < 4; ++i) kfs.push_back(t.add_keyframe());
+  auto [kfs, f] = DescriptorKeyframes(t);
   // Descriptors at index 5: a = 0, b = byte0 set (8 bits), c = bytes 0,1 (16), d = byte0 + one bit of byte2.
   // Pairwise: ab 8, ac 16, ad 9, bc 8, bd 1, cd 9. Median (with self, index (n-1)/2) per row:
   // a 8, b 1, c 8, d 1 -> b (first of the tie) is the distinctive descriptor.
-  std::vector<std::shared_ptr<FrameFeatures>> f;
-  for (auto& kf : kfs) {
-    f.push_back(std::const_pointer_cast<FrameFeatures>(kf->features));
-    f.back()->descriptors.row(5).setTo(0);
-  }
   f[1]->descriptors.at<uint8_t>(5, 0) = 0xFF;
   f[2]->descriptors.at<uint8_t>(5, 0) = 0xFF;
   f[2]->descriptors.at<uint8_t>(5, 1) = 0xFF;
@@ -202,13 +209,7 @@ TEST(MapPoint, DistinctiveDescriptorFollowsItsObservations) {
   // Computed once per set of observations (MapPoint::compute_distinctive_descriptor skips a repeat):
   // adding or erasing an observation, or setting the descriptor from outside, makes the next call count.
   TestMap t;
-  std::vector<std::shared_ptr<KeyFrame>> kfs;
-  for (int i = 0; i < 4; ++i) kfs.push_back(t.add_keyframe());
-  std::vector<std::shared_ptr<FrameFeatures>> f;
-  for (auto& kf : kfs) {
-    f.push_back(std::const_pointer_cast<FrameFeatures>(kf->features));
-    f.back()->descriptors.row(5).setTo(0);
-  }
+  auto [kfs, f] = DescriptorKeyframes(t);
   // a = 0, b = all ones, c = all ones but 4 bits, d = 0.
   f[1]->descriptors.row(5).setTo(0xFF);
   f[2]->descriptors.row(5).setTo(0xFF);

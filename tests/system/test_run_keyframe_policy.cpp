@@ -11,6 +11,7 @@
 #include "crowdslam/run/run_sequence.h"
 #include "crowdslam/synth/options.h"
 #include "crowdslam/synth/writer.h"
+#include "run_test_options.h"
 #include "test_support.h"
 
 using namespace crowdslam;
@@ -22,13 +23,8 @@ run::RunSummary run_with_ratio(const std::filesystem::path& dataset, const std::
   const auto settings = out.parent_path() / (out.filename().string() + ".yaml");
   test::write_text(settings,
                    test::read_text(dataset / "settings.yaml") + "\nTracking.keyframe_reference_ratio: " + ratio + "\n");
-  run::RunOptions o;
-  o.dataset = dataset.string();
-  o.out_dir = out.string();
+  run::RunOptions o = test::sequential_run_options(dataset, out);  // the empty room: no people filter
   o.settings_path = settings.string();
-  o.sequential = true;
-  o.progress = false;
-  o.people_filter = false;  // the empty room
   return run::run_sequence(o);
 }
 
