@@ -204,13 +204,21 @@ TEST(ViewerHostile, TooManyClientsGetA503) {
   const auto fourth = request(port, "GET", "/events");
   EXPECT_EQ(fourth.rfind("HTTP/1.1 503", 0), 0u) << fourth;
   EXPECT_NE(fourth.find("too many viewers"), std::string::npos);
-  // Three streams and three idle sockets fill the connections: the next gets a 503 at once.
+  // Three streams and three idle sockets fill the connections: the next gets a 503 at once. (The server
+  // counts a connection until it has finished with it, a moment after the client saw its answer.)
+  const auto wait_for_connections = [&](size_t n) {
+    for (const auto until = Clock::now() + 3s; Clock::now() < until && live.server->connections() != n;)
+      std::this_thread::sleep_for(10ms);
+    return live.server->connections();
+  };
+  ASSERT_EQ(wait_for_connections(3), 3u);
   std::vector<std::unique_ptr<Socket>> idle;
   for (int i = 0; i < 3; ++i) idle.push_back(std::make_unique<Socket>(port));
-  std::this_thread::sleep_for(300ms);
-  EXPECT_EQ(request(port, "GET", "/state").rfind("HTTP/1.1 503", 0), 0u);
+  ASSERT_EQ(wait_for_connections(6), 6u);
+  const auto full = request(port, "GET", "/state");
+  EXPECT_EQ(full.rfind("HTTP/1.1 503", 0), 0u) << "[" << full << "]";
   idle.clear();  // they go away: served again
-  std::this_thread::sleep_for(300ms);
+  ASSERT_EQ(wait_for_connections(3), 3u);
   EXPECT_EQ(request(port, "GET", "/state").rfind("HTTP/1.1 200", 0), 0u);
 }
 

@@ -50,6 +50,8 @@ class ViewerServer {
   // Unique to this server (process and start time): every event stream begins with it, so that a page
   // left open across runs sees a new run when it reconnects and starts afresh. GET /state shows it.
   [[nodiscard]] const std::string& session() const { return session_; }
+  // Connections open now (each counted until the server has finished with it); 0 before start().
+  [[nodiscard]] size_t connections() const { return server_ ? server_->connections() : 0; }
 
  private:
   ViewerServerOptions options_;
