@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "crowdslam/geometry/two_view.h"
@@ -241,6 +242,48 @@ TEST(TwoView, ReconstructsPlanarSceneThroughHomography) {
   EXPECT_EQ(r->model, TwoViewModel::kHomography);
   EXPECT_LT(rotation_error_deg(r->cam2_from_cam1, pose), 0.5);
   EXPECT_LT(direction_error_deg(r->cam2_from_cam1.translation(), pose.translation()), 2.0);
+}
+
+// A wall seen while the camera turns and moves sideways and back (a monocular camera re-anchoring where
+// people left only a wall in view): the homography's two decompositions both put every point in front of
+// both cameras, so without a prior the pair is ambiguous; a motion model's prediction tells them apart.
+TEST(TwoView, APlanesTwoFoldAmbiguityIsResolvedByAMotionPrior) {
+  const SE3 pose = relative_pose(12.0, 1.0, Vec3(-0.25, -0.01, 0.12));
+  const Vec3 normal = Vec3(0.05, 0.0, 1.0).normalized();
+  const auto c = make_correspondences(plane_points(400, normal, 3.0, 21), pose, 0.5, 20, 22);
+  TwoViewModels models;
+  EXPECT_FALSE(
+      reconstruct_two_view(test_camera(), c.points1, c.points2, TwoViewOptions{}, &models).has_value());
+  ASSERT_EQ(models.selected, TwoViewModel::kHomography);
+  // The twin: the other decomposition with every point good (it differs from the truth).
+  std::optional<SE3> twin;
+  for (const auto& p : poses_from_homography(models.homography_21, test_camera().intrinsic_matrix())) {
+    const auto check = check_relative_pose(p, test_camera(), c.points1, c.points2, models.homography.inliers, 1.0);
+    if (check.num_good > 0.9 * models.homography.num_inliers && rotation_error_deg(p, pose) > 1.0) twin = p;
+  }
+  ASSERT_TRUE(twin.has_value());
+  // A motion model's prediction: 3 degrees and 20 degrees of travel direction off the truth, metric.
+  TwoViewPrior prior;
+  prior.cam2_from_cam1 = SE3(relative_pose(15.0, 0.0, Vec3::Zero()).rotation(),
+                             Eigen::AngleAxisd(20.0 * kDeg, Vec3::UnitY()) * pose.translation() * 0.1);
+  const auto r = reconstruct_two_view(test_camera(), c.points1, c.points2, TwoViewOptions{}, nullptr, &prior);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_LT(rotation_error_deg(r->cam2_from_cam1, pose), 0.5);
+  EXPECT_LT(direction_error_deg(r->cam2_from_cam1.translation(), pose.translation()), 2.0);
+  // A prior near the twin gives the twin: the prior chooses, the points cannot.
+  prior.cam2_from_cam1 = *twin;
+  const auto t = reconstruct_two_view(test_camera(), c.points1, c.points2, TwoViewOptions{}, nullptr, &prior);
+  ASSERT_TRUE(t.has_value());
+  EXPECT_LT(rotation_error_deg(t->cam2_from_cam1, *twin), 0.5);
+  // A prior that agrees with neither (turning the other way, travelling the other way): nothing.
+  prior.cam2_from_cam1 = SE3(relative_pose(-12.0, 0.0, Vec3::Zero()).rotation(), -pose.translation());
+  EXPECT_FALSE(
+      reconstruct_two_view(test_camera(), c.points1, c.points2, TwoViewOptions{}, nullptr, &prior).has_value());
+  // Without a travel direction to check, the rotation alone decides, where it can.
+  prior.cam2_from_cam1 = pose;
+  prior.check_direction = false;
+  EXPECT_TRUE(agrees_with_prior(pose, prior));
+  EXPECT_FALSE(agrees_with_prior(relative_pose(30.0, 0.0, pose.translation()), prior));
 }
 
 TEST(TwoView, RejectsPureRotationAndTinyBaseline) {

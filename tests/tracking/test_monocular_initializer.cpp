@@ -278,3 +278,55 @@ TEST_F(MonocularInit, APlacedMapLandsWhereTheMotionSaysAtItsScale) {
   EXPECT_FALSE(placement.scaled_by_baseline);
   EXPECT_NEAR(other.keyframes().front()->scene_median_depth(), 2.0, 1e-3);
 }
+
+// A wall filling the view while the camera turns and moves sideways (a re-anchoring where people left
+// only a wall): the homography's two decompositions explain every match, so the two views alone do not
+// initialise; with the motion's prediction as the prior they do, at the true relative pose, and a prior
+// that disagrees with both decompositions keeps them from it.
+TEST_F(MonocularInit, AMotionPriorInitialisesOnAWallAndAWrongOneDoesNot) {
+  // 1.5 m in front of the -y wall (y = -2.5), looking at it: camera z = -y, y = -z (down), x = -x.
+  geometry::Mat3 r;
+  r << -1, 0, 0, 0, 0, -1, 0, -1, 0;
+  const geometry::SE3 first_pose(Eigen::Quaterniond(r), geometry::Vec3(0.0, -1.0, 1.5));
+  // 10 degrees of pan about the camera's vertical and 15 cm to the side, 5 cm back.
+  const geometry::SE3 motion(Eigen::Quaterniond(Eigen::AngleAxisd(10.0 * kDeg, geometry::Vec3::UnitY())),
+                             geometry::Vec3(-0.15, 0.0, -0.05));
+  const geometry::SE3 second_pose = first_pose * motion;  // world_from_cam
+  const geometry::SE3 truth = second_pose.inverse() * first_pose;  // cam2_from_cam1
+  const cv::Mat first = synth::render(*scene_, first_pose, {}).colour;
+  const cv::Mat second = synth::render(*scene_, second_pose, {}).colour;
+
+  tracking::MonocularInitializer alone;
+  alone.add_frame(make_frame(0, first));
+  EXPECT_FALSE(alone.add_frame(make_frame(1, second)).has_value());
+  EXPECT_GT(alone.last_num_matches(), 100);  // matched, but ambiguous
+
+  // The prior as a motion model gives it: 2 degrees and 15 degrees of travel direction off, another scale.
+  tracking::MonocularInitializer with_prior;
+  geometry::TwoViewPrior prior;
+  prior.cam2_from_cam1 =
+      geometry::SE3(Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * kDeg, geometry::Vec3::UnitY())) * truth.rotation(),
+                    Eigen::AngleAxisd(15.0 * kDeg, geometry::Vec3::UnitY()) * truth.translation() * 0.3);
+  with_prior.set_prior([&](double reference_s, double current_s) {
+    EXPECT_EQ(reference_s, 0.0);  // the two frames' timestamps
+    EXPECT_EQ(current_s, 1.0);
+    return std::optional<geometry::TwoViewPrior>(prior);
+  });
+  with_prior.add_frame(make_frame(0, first));
+  const auto init = with_prior.add_frame(make_frame(1, second));
+  ASSERT_TRUE(init.has_value());
+  EXPECT_EQ(init->model, geometry::TwoViewModel::kHomography);
+  EXPECT_LT(rotation_error_deg(init->current_from_reference, truth), 0.5);
+  EXPECT_LT(direction_error_deg(init->current_from_reference.translation(), truth.translation()), 3.0);
+
+  // Turning the other way: no decomposition agrees, no initialisation (and none after reset() either:
+  // the prior stays until clear_prior()).
+  prior.cam2_from_cam1 = geometry::SE3(truth.rotation().inverse(), -truth.translation());
+  with_prior.reset();
+  with_prior.add_frame(make_frame(0, first));
+  EXPECT_FALSE(with_prior.add_frame(make_frame(1, second)).has_value());
+  with_prior.clear_prior();
+  with_prior.reset();
+  with_prior.add_frame(make_frame(0, first));
+  EXPECT_FALSE(with_prior.add_frame(make_frame(1, second)).has_value());  // ambiguous again
+}

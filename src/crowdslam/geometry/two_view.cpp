@@ -415,16 +415,36 @@ PoseCheck check_relative_pose(const SE3& cam2_from_cam1, const PinholeCamera& ca
   return out;
 }
 
+bool agrees_with_prior(const SE3& cam2_from_cam1, const TwoViewPrior& prior) {
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  const double prior_angle = Eigen::AngleAxisd(prior.cam2_from_cam1.rotation()).angle() * kDeg;
+  const double rotation_error =
+      Eigen::AngleAxisd(cam2_from_cam1.rotation() * prior.cam2_from_cam1.rotation().inverse()).angle() * kDeg;
+  if (rotation_error > prior.max_rotation_deg + prior.rotation_share * prior_angle) return false;
+  if (!prior.check_direction) return true;
+  // The direction of travel: the second camera's centre in the first camera's frame.
+  const Vec3 travel = -(cam2_from_cam1.rotation().inverse() * cam2_from_cam1.translation());
+  const Vec3 predicted = -(prior.cam2_from_cam1.rotation().inverse() * prior.cam2_from_cam1.translation());
+  if (travel.norm() == 0 || predicted.norm() == 0) return false;
+  const double cosine = std::clamp(travel.normalized().dot(predicted.normalized()), -1.0, 1.0);
+  return std::acos(cosine) * kDeg <= prior.max_direction_deg;
+}
+
 std::optional<TwoViewReconstruction> choose_hypothesis(
     const std::vector<SE3>& candidates, const PinholeCamera& camera, const std::vector<Vec2>& points1,
-    const std::vector<Vec2>& points2, const ModelScore& model, const TwoViewOptions& options) {
+    const std::vector<Vec2>& points2, const ModelScore& model, const TwoViewOptions& options,
+    const TwoViewPrior* prior) {
   if (candidates.empty()) return std::nullopt;
   std::vector<PoseCheck> checks;
   checks.reserve(candidates.size());
   size_t best = 0;
   for (size_t i = 0; i < candidates.size(); ++i) {
-    checks.push_back(
-        check_relative_pose(candidates[i], camera, points1, points2, model.inliers, options.sigma_px));
+    if (prior && !agrees_with_prior(candidates[i], *prior)) {
+      checks.emplace_back();  // takes no part: no good points
+    } else {
+      checks.push_back(
+          check_relative_pose(candidates[i], camera, points1, points2, model.inliers, options.sigma_px));
+    }
     if (checks[i].num_good > checks[best].num_good) best = i;
   }
   const int best_good = checks[best].num_good;
@@ -451,29 +471,39 @@ std::optional<TwoViewReconstruction> reconstruct_two_view(const PinholeCamera& c
                                                           const std::vector<Vec2>& points1,
                                                           const std::vector<Vec2>& points2,
                                                           const TwoViewOptions& options,
-                                                          TwoViewModels* models) {
+                                                          TwoViewModels* models, const TwoViewPrior* prior) {
   if (points1.size() != points2.size() || points1.size() < static_cast<size_t>(kSampleSize))
     return std::nullopt;
   TwoViewModels estimated = estimate_two_view_models(points1, points2, options);
   const Mat3 k = camera.intrinsic_matrix();
-  std::optional<TwoViewReconstruction> out;
-  if (estimated.selected == TwoViewModel::kHomography) {
-    out = choose_hypothesis(poses_from_homography(estimated.homography_21, k), camera, points1, points2,
-                            estimated.homography, options);
-  } else {
-    // Non-linear refinement of F on its inliers, kept when it scores at least as well.
-    const Mat3 refined =
-        refine_fundamental(estimated.fundamental_21, k, points1, points2, estimated.fundamental.inliers);
-    ModelScore refined_score = score_fundamental(refined, points1, points2, options.sigma_px);
-    if (refined_score.score >= estimated.fundamental.score) {
-      estimated.fundamental_21 = refined;
-      estimated.fundamental = std::move(refined_score);
+  const auto from_homography = [&] {
+    return choose_hypothesis(poses_from_homography(estimated.homography_21, k), camera, points1, points2,
+                             estimated.homography, options, prior);
+  };
+  bool refined_fundamental = false;
+  const auto from_fundamental = [&] {
+    if (!refined_fundamental) {  // non-linear refinement of F on its inliers, kept when it scores as well
+      refined_fundamental = true;
+      const Mat3 refined =
+          refine_fundamental(estimated.fundamental_21, k, points1, points2, estimated.fundamental.inliers);
+      ModelScore refined_score = score_fundamental(refined, points1, points2, options.sigma_px);
+      if (refined_score.score >= estimated.fundamental.score) {
+        estimated.fundamental_21 = refined;
+        estimated.fundamental = std::move(refined_score);
+      }
     }
     const Mat3 essential = k.transpose() * estimated.fundamental_21 * k;
-    out = choose_hypothesis(poses_from_essential(essential), camera, points1, points2, estimated.fundamental,
-                            options);
+    return choose_hypothesis(poses_from_essential(essential), camera, points1, points2, estimated.fundamental,
+                             options, prior);
+  };
+  const bool homography = estimated.selected == TwoViewModel::kHomography;
+  std::optional<TwoViewReconstruction> out = homography ? from_homography() : from_fundamental();
+  TwoViewModel model = estimated.selected;
+  if (!out && prior) {  // the prior can vouch for the other model's hypothesis (step 5)
+    out = homography ? from_fundamental() : from_homography();
+    model = homography ? TwoViewModel::kFundamental : TwoViewModel::kHomography;
   }
-  if (out) out->model = estimated.selected;
+  if (out) out->model = model;
   if (models) *models = std::move(estimated);
   return out;
 }

@@ -16,6 +16,12 @@
 //    winner (no other has more than clear_winner_ratio of its count), its good points are at least
 //    max(min_good_fraction * inliers, min_triangulated), and the parallax of its 50th-best point
 //    exceeds min_parallax_deg. Pure rotations and too-small baselines therefore fail.
+// 5. With a prior (TwoViewPrior: the relative pose a motion model predicts, as when a monocular map is
+//    re-anchored), only hypotheses that agree with it take part in step 4, and when the selected model
+//    has none, the other model's hypotheses are tried. A plane seen from two views has two
+//    decompositions that explain every point (the two-fold ambiguity of a homography); they differ in
+//    rotation and in the direction of travel, and the prior tells them apart where step 4 alone rejects
+//    the pair as ambiguous.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -58,6 +64,18 @@ ModelScore score_homography(const Mat3& homography_21, const std::vector<Vec2>& 
 ModelScore score_fundamental(const Mat3& fundamental_21, const std::vector<Vec2>& points1,
                              const std::vector<Vec2>& points2, double sigma_px);
 
+// The relative pose another source predicts (step 5). A hypothesis agrees when its rotation is within
+// max_rotation_deg + rotation_share * (the prior's rotation angle) of the prior's, and, when
+// check_direction, its direction of travel within max_direction_deg of the prior's.
+struct TwoViewPrior {
+  SE3 cam2_from_cam1;
+  bool check_direction = true;  // false when the prior's translation is too short to have a direction
+  double max_rotation_deg = 2.0;
+  double rotation_share = 0.5;
+  double max_direction_deg = 45.0;
+};
+bool agrees_with_prior(const SE3& cam2_from_cam1, const TwoViewPrior& prior);
+
 struct TwoViewModels {
   Mat3 homography_21 = Mat3::Zero();
   ModelScore homography;
@@ -97,16 +115,19 @@ struct TwoViewReconstruction {
   double parallax_deg = 0.0;
 };
 
-// Picks the winning hypothesis among `candidates` (see the header comment), or nullopt.
+// Picks the winning hypothesis among `candidates` (see the header comment; with `prior`, among those that
+// agree with it), or nullopt.
 std::optional<TwoViewReconstruction> choose_hypothesis(
     const std::vector<SE3>& candidates, const PinholeCamera& camera, const std::vector<Vec2>& points1,
-    const std::vector<Vec2>& points2, const ModelScore& model, const TwoViewOptions& options);
+    const std::vector<Vec2>& points2, const ModelScore& model, const TwoViewOptions& options,
+    const TwoViewPrior* prior = nullptr);
 
 // The whole pipeline: models, selection, reconstruction. `models` (optional) receives the estimates.
 std::optional<TwoViewReconstruction> reconstruct_two_view(const PinholeCamera& camera,
                                                           const std::vector<Vec2>& points1,
                                                           const std::vector<Vec2>& points2,
                                                           const TwoViewOptions& options,
-                                                          TwoViewModels* models = nullptr);
+                                                          TwoViewModels* models = nullptr,
+                                                          const TwoViewPrior* prior = nullptr);
 
 }  // namespace crowdslam::geometry

@@ -119,8 +119,10 @@ std::optional<TwoViewInitialization> MonocularInitializer::add_frame(const map::
     points2.emplace_back(frame.features->keys_un[j].pt.x, frame.features->keys_un[j].pt.y);
   }
   geometry::TwoViewModels models;
-  const auto reconstruction =
-      geometry::reconstruct_two_view(*frame.camera, points1, points2, options_.two_view, &models);
+  std::optional<geometry::TwoViewPrior> prior;
+  if (prior_) prior = prior_(reference_->timestamp_s, frame.timestamp_s);
+  const auto reconstruction = geometry::reconstruct_two_view(*frame.camera, points1, points2, options_.two_view,
+                                                             &models, prior ? &*prior : nullptr);
   if (!reconstruction) {
     spdlog::debug("monocular init: frame {} vs {}: {} matches, R_H {:.2f}, no reconstruction", frame.id,
                   reference_->id, matches.size(), models.homography_ratio);

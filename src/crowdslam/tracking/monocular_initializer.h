@@ -10,11 +10,15 @@
 // motion.
 // Reference policy: a frame with too few keypoints never becomes the reference; a current frame with too
 // few keypoints or too few matches becomes the new reference (retry).
+// Prior: when re-anchoring a map, a motion model predicts the relative pose of the two views
+// (set_prior); the two-view step then keeps only hypotheses that agree with it (geometry/two_view.h,
+// step 5), which resolves a plane's two-fold ambiguity and rejects reconstructions the motion rules out.
 //
 // build_initial_map() then creates two keyframes (the reference at the origin), the triangulated points,
 // runs a bundle adjustment of the two with the first fixed, removes outlier observations, scales the map
 // so that the first keyframe's median scene depth is 1, and checks that enough points survive.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -60,6 +64,11 @@ class MonocularInitializer {
   // Offers a frame (undistorted keypoints, no pose needed). Returns the reconstruction when this frame
   // and the reference give one; otherwise keeps or replaces the reference and returns nullopt.
   std::optional<TwoViewInitialization> add_frame(const map::Frame& frame);
+  // Gives the relative pose (reference frame -> current frame) predicted between two timestamps, or
+  // nullopt; kept across reset(), removed by clear_prior().
+  using Prior = std::function<std::optional<geometry::TwoViewPrior>(double reference_s, double current_s)>;
+  void set_prior(Prior prior) { prior_ = std::move(prior); }
+  void clear_prior() { prior_ = nullptr; }
   void reset();
   [[nodiscard]] bool has_reference() const { return reference_ != nullptr; }
   [[nodiscard]] const map::Frame* reference() const { return reference_.get(); }
@@ -75,6 +84,7 @@ class MonocularInitializer {
   std::shared_ptr<map::Frame> reference_;
   std::vector<cv::Point2f> previous_positions_;  // per reference keypoint
   int last_num_matches_ = 0;
+  Prior prior_;
 };
 
 // Where a two-view map goes in a map that already holds keyframes (monocular re-anchoring, tracker's

@@ -76,6 +76,7 @@ void Tracker::reset() {
   bridge_motion_.reset();
   bridge_recent_motion_.reset();
   reanchor_.reset();
+  reanchor_keyframe_ids_ = {1, 0};
   frames_since_loss_.clear();
   recent_poses_.clear();
   scene_depth_m_ = 0;

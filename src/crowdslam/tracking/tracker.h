@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "crowdslam/bow/vocabulary.h"
 #include "crowdslam/map/frame.h"
@@ -367,6 +368,8 @@ class Tracker {
   // when the keyframe has the frame's keypoints as they are.
   std::vector<long> last_keyframe_indices_;
   uint64_t last_relocalization_frame_id_ = 0;
+  // The two keyframes the last monocular re-anchoring made (ids; first > second when none).
+  std::pair<uint64_t, uint64_t> reanchor_keyframe_ids_{1, 0};
   // What the next frame waits for after a monocular keyframe (Tracker::track): nothing, the keyframe's
   // new points (triangulation and fusion; an unpaced replay), or the whole mapping of it, local BA
   // included (after weak tracking).

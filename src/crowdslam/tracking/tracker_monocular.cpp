@@ -129,7 +129,13 @@ Tracker::KeyframeDecision Tracker::need_new_keyframe_monocular(const map::Frame&
       num_keyframes > max_frames) {
     return KeyframeDecision::kNo;
   }
-  const int min_observations = num_keyframes <= 2 ? 2 : 3;
+  // Points seen by 3 keyframes, as ORB-SLAM2, except while the reference is one of the map's first two
+  // keyframes or of the two a re-anchoring placed: their points have two observations, and counting only
+  // 3 would hold back keyframes until tracking is weak while the camera moves on into the view they
+  // started (this lost re-anchored crowds again within a second).
+  const bool two_view_reference = reference_keyframe_ && reference_keyframe_->id >= reanchor_keyframe_ids_.first &&
+                                  reference_keyframe_->id <= reanchor_keyframe_ids_.second;
+  const int min_observations = num_keyframes <= 2 || two_view_reference ? 2 : 3;
   const int reference_matches =
       reference_keyframe_ ? reference_keyframe_->tracked_map_points(min_observations) : 0;
   const bool mapper_idle = mapper_->accepts_keyframes();

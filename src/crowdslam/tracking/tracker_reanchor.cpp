@@ -13,6 +13,10 @@
 
 namespace crowdslam::tracking {
 
+namespace {
+constexpr double kReanchorPriorS = 1.0;
+}  // namespace
+
 MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOptions options) {
   // What people leave of a view is a few hundred keypoints: all pyramid levels up to 2 take part, and
   // fewer matches and points do (the placement, not the two views alone, fixes the pose).
@@ -25,6 +29,7 @@ MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOpt
 void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double lost_since_s) {
   reanchor_.reset();
   reanchor_initializer_.reset();
+  reanchor_initializer_.clear_prior();
   frames_since_loss_.clear();
   if (options_.reanchor_max_s <= 0 || !motion || map_loaded_ || localization_only_) return;
   if (map_->num_keyframes() <= static_cast<size_t>(options_.reset_if_lost_within_keyframes)) return;
@@ -32,6 +37,19 @@ void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double l
   const float depth = reference ? reference->scene_median_depth() : 0.0F;
   if (!(depth > 0)) return;
   reanchor_ = Reanchor{*motion, lost_since_s, depth, reference};
+  // The two views must agree with the motion tracked before the loss: where the people left a plane (a
+  // wall) its two decompositions both explain every match, and only the motion tells them apart. The
+  // motion is trusted for kReanchorPriorS after the last pose: later (a long blackout) the camera may have
+  // changed its motion, and the two views decide alone, as at the start.
+  reanchor_initializer_.set_prior([motion = *motion, depth](double reference_s, double current_s) {
+    if (current_s - motion.anchor_s > kReanchorPriorS) return std::optional<geometry::TwoViewPrior>();
+    geometry::TwoViewPrior prior;
+    prior.cam2_from_cam1 = motion.at(current_s) * motion.at(reference_s).inverse();
+    // A travel under 1 % of the scene depth has no direction to speak of (the views' parallax is below
+    // what an initialisation needs anyway).
+    prior.check_direction = prior.cam2_from_cam1.translation().norm() >= 0.01 * depth;
+    return std::optional<geometry::TwoViewPrior>(prior);
+  });
 }
 
 bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
@@ -93,6 +111,7 @@ bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
   result.recovered = std::move(around.recovered);
   result.recovered.emplace_back(first->frame_id, first->cam_from_world());
   result.recovered_reference = first;
+  reanchor_keyframe_ids_ = {std::min(first->id, second->id), std::max(first->id, second->id)};
   if (result.recovered.size() > 1) {
     spdlog::info("monocular re-anchoring: {} lost frames localised in the map", result.recovered.size() - 1);
   }
