@@ -372,9 +372,22 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       last_bridged_s_ = frame.timestamp_s;
       lost_frames_ = 0;
       result.bridged_cam_from_world = frame.cam_from_world;
+      // Monocular, onto a view the map does not hold with background to see: a two-view map there now
+      // rather than after the bridge (tracker_reanchor.cpp).
+      if (!localization_only_ && !map_loaded_ && reanchor_while_bridged(frame, motion, result)) {
+        state_ = TrackingState::kOk;
+        result.method = "reanchor";
+        result.new_keyframe = true;
+        result.bridged_cam_from_world.reset();
+        bridge_motion_.reset();
+      }
     } else {
       if (options_.monocular && lost_frames_ == 0) {
-        start_reanchor(after_bridge ? bridge_motion_ : recent_motion(frame, velocity_at_start), frame.timestamp_s);
+        if (reanchor_ && after_bridge) {
+          reanchor_->lost_since_s = frame.timestamp_s;  // started while bridged: the clock runs from now
+        } else {
+          start_reanchor(after_bridge ? bridge_motion_ : recent_motion(frame, velocity_at_start), frame.timestamp_s);
+        }
       }
       velocity_.reset();
       bridge_motion_.reset();

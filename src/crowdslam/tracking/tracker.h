@@ -343,6 +343,11 @@ class Tracker {
   // meanwhile in it (result.recovered). True when `frame` is tracked.
   void start_reanchor(const std::optional<BridgeMotion>& motion, double lost_since_s);
   bool reanchor(map::Frame& frame, TrackResult& result);
+  // A monocular bridged frame (pose from `motion`) whose view the map does not hold but which keeps
+  // enough background off the people (bridge_resume_min_keypoints, fewer than
+  // bridge_resume_max_map_points map points near its keypoints) is offered to re-anchoring, started
+  // then if need be. True when it re-anchored (`frame` tracked).
+  bool reanchor_while_bridged(map::Frame& frame, const std::optional<BridgeMotion>& motion, TrackResult& result);
 
   TrackerOptions options_;
   std::shared_ptr<map::Map> map_;
@@ -381,7 +386,8 @@ class Tracker {
   std::optional<BridgeMotion> bridge_recent_motion_;  // the last frame before the bridge at its velocity
   struct Reanchor {
     BridgeMotion motion;          // from the last pose before the loss
-    double lost_since_s = 0;      // the first lost frame (after a bridge: when the view cleared)
+    double lost_since_s = 0;      // the first lost frame (after a bridge: when the view cleared), or
+                                  // the bridged frame it started at
     double median_depth = 1;      // of the reference keyframe then
     std::shared_ptr<map::KeyFrame> keyframe;  // that reference keyframe (the new part's parent)
   };

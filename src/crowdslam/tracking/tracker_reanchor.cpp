@@ -52,6 +52,24 @@ void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double l
   });
 }
 
+bool Tracker::reanchor_while_bridged(map::Frame& frame, const std::optional<BridgeMotion>& motion,
+                                     TrackResult& result) {
+  if (!options_.monocular || options_.reanchor_max_s <= 0 || !motion || !frame.cam_from_world) return false;
+  size_t background = 0;
+  for (size_t i = 0; i < frame.size(); ++i) background += !frame.in_box[i] && !frame.dynamic[i];
+  if (options_.bridge_resume_min_keypoints <= 0 ||
+      background < static_cast<size_t>(options_.bridge_resume_min_keypoints) ||
+      map_points_near_keypoints(frame) >= static_cast<size_t>(options_.bridge_resume_max_map_points)) {
+    return false;  // people hide the view, or the map holds it (relocalisation will find it)
+  }
+  if (!reanchor_) start_reanchor(motion, frame.timestamp_s);
+  if (!reanchor_) return false;
+  const geometry::SE3 bridged = *frame.cam_from_world;
+  if (reanchor(frame, result)) return true;
+  frame.cam_from_world = bridged;  // still bridged
+  return false;
+}
+
 bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
   // Counted from the loss, like the new-map clock: after a bridge, from when the view cleared.
   if (frame.timestamp_s - reanchor_->lost_since_s > options_.reanchor_max_s) {
