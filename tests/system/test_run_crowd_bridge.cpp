@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "crowdslam/synth/sprites.h"
 #include "test_support.h"
@@ -27,6 +28,24 @@ std::string missing_inputs() {
   }
   return "";
 }
+
+// `synth --frames 300 --seed 5 --people N --crowd PROFILE [extra]` into `seq`.
+crowdslam::test::CliResult synth_crowd(const fs::path& seq, const std::string& profile, const std::string& people,
+                                       const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args{"-q",     "synth",    "--out", seq.string(), "--frames", "300", "--seed", "5",
+                                "--people", people, "--crowd", profile};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return run_cli(args);
+}
+
+// A sequential run of `seq` into `out` (`--allow-untracked`, and `extra`).
+crowdslam::test::CliResult run_sequential(const fs::path& seq, const fs::path& out,
+                                          const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args{"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sequential",
+                                "--allow-untracked"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return run_cli(args);
+}
 }  // namespace
 
 
@@ -34,12 +53,10 @@ TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPose
   if (const std::string why = missing_inputs(); !why.empty()) GTEST_SKIP() << why;
   crowdslam::test::TempDir tmp;
   const auto seq = tmp / "crowd";
-  const auto synth = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "300", "--seed", "5", "--people",
-                              "8", "--crowd", "passing", "--stereo"});
+  const auto synth = synth_crowd(seq, "passing", "8", {"--stereo"});
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const auto out = tmp / "run";
-  const auto run = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sequential",
-                            "--allow-untracked"});
+  const auto run = run_sequential(seq, out);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
   const auto& summary = doc["summary"];
@@ -78,15 +95,13 @@ TEST(RunCrowdBridge, RgbdBlackoutTheDetectorMissesIsBridgedByDepthInOneMap) {
   if (const std::string why = missing_inputs(); !why.empty()) GTEST_SKIP() << why;
   crowdslam::test::TempDir tmp;
   const auto seq = tmp / "blackout";
-  const auto synth = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "300", "--seed", "5", "--people",
-                              "8", "--crowd", "blackout"});
+  const auto synth = synth_crowd(seq, "blackout", "8");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const auto planned = nlohmann::json::parse(crowdslam::test::read_text(seq / "synth.json"))["blackout_frames"];
   const int first = planned[0].get<int>();
   const int last = planned[1].get<int>();
   const auto out = tmp / "run";
-  const auto run = run_cli({"-q", "run", "--dataset", seq.string(), "--out", out.string(), "--sequential",
-                            "--allow-untracked"});
+  const auto run = run_sequential(seq, out);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
   EXPECT_EQ(doc["summary"]["map_resets"].get<int>(), 0);
@@ -123,12 +138,11 @@ TEST(RunCrowdBridge, MonocularReanchorsWhileBridgedOntoAViewTheMapNeverSaw) {
   if (const std::string why = missing_inputs(); !why.empty()) GTEST_SKIP() << why;
   crowdslam::test::TempDir tmp;
   const auto seq = tmp / "standing";
-  const auto synth = run_cli({"-q", "synth", "--out", seq.string(), "--frames", "300", "--seed", "5", "--people",
-                              "30", "--crowd", "standing"});
+  const auto synth = synth_crowd(seq, "standing", "30");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const auto out = tmp / "run";
-  const auto run = run_cli({"-q", "run", "--dataset", seq.string(), "--detections", (seq / "people_gt.txt").string(),
-                            "--sensor", "mono", "--out", out.string(), "--sequential", "--allow-untracked"});
+  const auto run =
+      run_sequential(seq, out, {"--detections", (seq / "people_gt.txt").string(), "--sensor", "mono"});
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
   const auto& summary = doc["summary"];

@@ -416,10 +416,11 @@ PoseCheck check_relative_pose(const SE3& cam2_from_cam1, const PinholeCamera& ca
 }
 
 bool agrees_with_prior(const SE3& cam2_from_cam1, const TwoViewPrior& prior) {
-  constexpr double kDeg = 180.0 / 3.14159265358979323846;
-  const double prior_angle = Eigen::AngleAxisd(prior.cam2_from_cam1.rotation()).angle() * kDeg;
+  constexpr double kDeg = 180.0 / kPi;
+  const Mat3 predicted_rotation = prior.cam2_from_cam1.rotation_matrix();
+  const double prior_angle = rotation_angle(predicted_rotation) * kDeg;
   const double rotation_error =
-      Eigen::AngleAxisd(cam2_from_cam1.rotation() * prior.cam2_from_cam1.rotation().inverse()).angle() * kDeg;
+      rotation_angle(cam2_from_cam1.rotation_matrix() * predicted_rotation.transpose()) * kDeg;
   if (rotation_error > prior.max_rotation_deg + prior.rotation_share * prior_angle) return false;
   if (!prior.check_direction) return true;
   // The direction of travel: the second camera's centre in the first camera's frame.

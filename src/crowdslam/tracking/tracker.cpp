@@ -374,7 +374,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       result.bridged_cam_from_world = frame.cam_from_world;
       // Monocular, onto a view the map does not hold with background to see: a two-view map there now
       // rather than after the bridge (tracker_reanchor.cpp).
-      if (!localization_only_ && !map_loaded_ && reanchor_while_bridged(frame, motion, result)) {
+      if (reanchor_while_bridged(frame, motion, result)) {
         state_ = TrackingState::kOk;
         result.method = "reanchor";
         result.new_keyframe = true;

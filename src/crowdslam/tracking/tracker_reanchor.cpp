@@ -54,7 +54,10 @@ void Tracker::start_reanchor(const std::optional<BridgeMotion>& motion, double l
 
 bool Tracker::reanchor_while_bridged(map::Frame& frame, const std::optional<BridgeMotion>& motion,
                                      TrackResult& result) {
-  if (!options_.monocular || options_.reanchor_max_s <= 0 || !motion || !frame.cam_from_world) return false;
+  if (!options_.monocular || options_.reanchor_max_s <= 0 || map_loaded_ || localization_only_ || !motion ||
+      !frame.cam_from_world) {
+    return false;
+  }
   size_t background = 0;
   for (size_t i = 0; i < frame.size(); ++i) background += !frame.in_box[i] && !frame.dynamic[i];
   if (options_.bridge_resume_min_keypoints <= 0 ||
