@@ -60,6 +60,27 @@ TEST(KeypointFilter, DepthModeKeepsBackgroundBehindPerson) {
   EXPECT_EQ(filter_keypoints(kps, {person}, options, depth_m).removed, 4);
 }
 
+TEST(KeypointFilter, AWideBoxOffThePersonsCentreKeepsTheBackgroundWithALowQuantile) {
+  // A person at 1.5 m (x 40-69) at the left of a box twice their width (x 30-149, the body detector at
+  // 160 x 160): the box's central region (x 60-119) shows them in 10 of its 60 columns, the wall at 4 m
+  // in the rest.
+  cv::Mat depth(200, 200, CV_16UC1, cv::Scalar(4 * 5000));
+  depth(cv::Rect(40, 20, 30, 170)).setTo(static_cast<int>(1.5 * 5000));
+  const PersonBox wide = box(30, 20, 120, 170);
+  // The 30th percentile is the wall's depth: everything in the box would be filtered as the person.
+  EXPECT_NEAR(estimate_person_depth(depth, 5000.0, wide.box, 0.3), 4.0, 1e-9);
+  EXPECT_NEAR(estimate_person_depth(depth, 5000.0, wide.box, 0.1), 1.5, 1e-9);
+  const std::vector<cv::KeyPoint> kps{kp(55, 100), kp(100, 100), kp(140, 60)};  // person, wall, wall
+  const std::vector<float> depth_m{1.5f, 4.0f, 4.0f};
+  KeypointFilterOptions options;
+  options.mode = FilterMode::kDepth;
+  EXPECT_EQ(filter_keypoints(kps, {wide}, options, depth_m, depth, 5000.0).keep,
+            (std::vector<bool>{false, false, false}));
+  options.person_depth_quantile = 0.1;
+  EXPECT_EQ(filter_keypoints(kps, {wide}, options, depth_m, depth, 5000.0).keep,
+            (std::vector<bool>{false, true, true}));
+}
+
 TEST(KeypointFilter, SilhouettesDropsBackgroundKeypointsOnThePersonsOutline) {
   // The scene above: a person at 2 m (x 60-119, y 40-179) before a background at 5 m.
   cv::Mat depth(200, 200, CV_16UC1, cv::Scalar(5 * 5000));

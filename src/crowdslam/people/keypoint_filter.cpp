@@ -48,7 +48,8 @@ bool on_silhouette(const cv::Mat& depth_image_raw, double depth_factor, const cv
 
 }  // namespace
 
-double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box) {
+double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
+                             double quantile) {
   if (depth_image_raw.empty() || depth_image_raw.type() != CV_16UC1) return -1.0;
   // Central region: half the width, 70% of the height.
   const cv::Rect2f centre(box.x + 0.25f * box.width, box.y + 0.15f * box.height, 0.5f * box.width,
@@ -60,7 +61,8 @@ double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor
   if (region.area() <= 0) return -1.0;
   std::vector<uint16_t> values = sample_valid_depths(depth_image_raw, region, 2000);
   if (values.size() < 10) return -1.0;
-  const auto nth = values.begin() + static_cast<long>(values.size() * 3 / 10);
+  const double q = std::clamp(quantile, 0.0, 1.0);
+  const auto nth = values.begin() + std::min(static_cast<long>(values.size() * q), static_cast<long>(values.size()) - 1);
   std::nth_element(values.begin(), nth, values.end());
   return *nth / depth_factor;
 }
@@ -87,7 +89,8 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
                        b.box.height + 2 * margin);
     origin.push_back(static_cast<int>(k));
     if (options.mode == FilterMode::kDepth) {
-      result.person_depth_m.push_back(estimate_person_depth(depth_image_raw, depth_factor, b.box));
+      result.person_depth_m.push_back(
+          estimate_person_depth(depth_image_raw, depth_factor, b.box, options.person_depth_quantile));
     }
   }
   const bool use_depth = options.mode == FilterMode::kDepth && depth_m.size() == keypoints.size();

@@ -26,6 +26,9 @@ struct KeypointFilterOptions {
   double margin_px = 5.0;       // boxes grown by this on every side
   double depth_margin_m = 0.5;  // depth mode: keep keypoints this much behind the person
   bool silhouettes = true;      // depth mode: drop kept keypoints whose 5 x 5 neighbourhood shows the person
+  // Depth mode: the quantile of the box's central depths taken as the person's depth (estimate_person_depth).
+  // The people stage uses 0.1 with a depth camera's dense depth and 0.3 with stereo's sparse keypoint depths.
+  double person_depth_quantile = 0.3;
   void check() const;
 };
 
@@ -42,8 +45,12 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
                               const KeypointFilterOptions& options, const std::vector<float>& depth_m = {},
                               const cv::Mat& depth_image_raw = cv::Mat(), double depth_factor = 5000.0);
 
-// Robust depth of the person in `box`: the 30th percentile of the valid depths in its central region
-// (people stand in front of what their box also contains). Returns <= 0 when there is no depth there.
-double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box);
+// Robust depth of the person in `box`: the `quantile` of the valid depths in its central region (half its
+// width, 70 % of its height), low because people stand in front of what their box also contains. A
+// detector's box is often wider than the person or off their centre (the body detector at 160 x 160): the
+// person then covers less of the region than the background beside them, and a median there is the
+// background's depth, so the filter would take the background too. Returns <= 0 when there is no depth there.
+double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor, const cv::Rect2f& box,
+                             double quantile = 0.3);
 
 }  // namespace crowdslam::people

@@ -74,6 +74,9 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   filter_options_.margin_px = settings.people_filter.margin_px;
   filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
   filter_options_.silhouettes = settings.people_filter.silhouettes;
+  // Dense depth holds the person wherever they are in the box; stereo's sparse depths hold mismatches, so
+  // a low quantile there may be one of them.
+  filter_options_.person_depth_quantile = sensor_ == io::SensorKind::kRgbd ? 0.1 : 0.3;
   filter_options_.check();
   right_image_boxes_ = settings.people_filter.right_image == "boxes";
   flat_box_margin_m_ = settings.people_filter.flat_box_margin_m;

@@ -49,16 +49,35 @@ std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::S
 
 FramePoses localize_backwards(std::deque<map::Frame>& frames, geometry::SE3& later, geometry::SE3& step,
                               const std::vector<std::shared_ptr<map::MapPoint>>& points,
-                              const optim::PoseOptimizerOptions& options) {
+                              const optim::PoseOptimizerOptions& options, double max_gap_s) {
   FramePoses recovered;
+  std::deque<map::Frame> failed;  // skipped over, oldest first
+  geometry::SE3 guess_from = later;
+  bool gap = false;
+  double last_t = frames.empty() ? 0.0 : frames.back().timestamp_s;  // of the last frame localised
   while (!frames.empty()) {
-    const auto pose = localize_in_map(frames.back(), step * later, points, options);
-    if (!pose) break;
-    step = *pose * later.inverse();
+    const geometry::SE3 guess = step * guess_from;
+    const auto pose = localize_in_map(frames.back(), guess, points, options);
+    if (!pose) {
+      if (!(last_t - frames.back().timestamp_s < max_gap_s)) break;
+      // Skipped: the next earlier frame is guessed on from here by the same step.
+      gap = true;
+      guess_from = guess;
+      failed.push_front(std::move(frames.back()));
+      frames.pop_back();
+      continue;
+    }
+    // A step is measured only between neighbouring frames; over a gap the last one stays.
+    if (!gap) step = *pose * later.inverse();
     later = *pose;
+    guess_from = later;
+    gap = false;
+    last_t = frames.back().timestamp_s;
     recovered.emplace_back(frames.back().id, *pose);
     frames.pop_back();
   }
+  // What is left, oldest first: the frames not tried and those skipped.
+  for (auto& f : failed) frames.push_back(std::move(f));
   return recovered;
 }
 

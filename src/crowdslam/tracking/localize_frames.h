@@ -34,11 +34,14 @@ std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::S
                                              const optim::PoseOptimizerOptions& options);
 
 // Frames before `later` (newest last in `frames`, which keeps those that fail), each from the pose of the
-// frame after it moved by the last measured step; stops at the first failure. `step` is
-// cam_from_world(earlier) * world_from_cam(later) for one frame interval, as last measured.
+// frame after it moved by the last measured step. `step` is cam_from_world(earlier) * world_from_cam(later)
+// for one frame interval, as last measured. Stops at a failure more than `max_gap_s` before the last frame
+// localised (0: at the first failure); a failed frame within that is skipped, and the frame before it is
+// guessed on by the same step from where the failed one was guessed. On return `later` and `step` are those of the oldest frame
+// localised; `frames` holds, oldest first, the frames not tried and those skipped.
 FramePoses localize_backwards(std::deque<map::Frame>& frames, geometry::SE3& later, geometry::SE3& step,
                               const std::vector<std::shared_ptr<map::MapPoint>>& points,
-                              const optim::PoseOptimizerOptions& options);
+                              const optim::PoseOptimizerOptions& options, double max_gap_s = 0.0);
 
 // Frames around a two-view reconstruction whose reference frame `reference_id` (keyframe at `first_pose`,
 // time t0) and second view (`last_pose`, time t1) are in the map. Frames after the reference are guessed

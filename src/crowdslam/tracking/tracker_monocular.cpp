@@ -63,7 +63,8 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   // lie between the two keyframes (first pose guess: interpolated by time), those before the reference
   // are taken backwards from it (guess: the pose of the frame after, moved by the velocity between the
   // two frames after). Frames between the keyframes that fail are left lost; going backwards stops at
-  // the first failure, and the frames left are tried again when the map has grown (retry).
+  // the first failure, and the frames left are tried again when the map has grown (retry; the last
+  // retry skips over failures).
   frames_to_retry_.clear();
   retries_before_init_ = 0;
   if (frames_before_init_.empty() || !init_frame.cam_from_world) return {};
@@ -84,6 +85,7 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
 std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_init() {
   // Tried when the map has this many keyframes (the two-view map's keyframes are the first two).
   constexpr size_t kRetryKeyframes[] = {4, 8};
+  constexpr double kRetryMaxGapS = 0.5;
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
   if (frames_to_retry_.empty() || retries_before_init_ >= std::size(kRetryKeyframes) ||
       map_->num_keyframes() < kRetryKeyframes[retries_before_init_]) {
@@ -98,9 +100,13 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_ini
     return recovered;
   }
   geometry::SE3 later = retry_anchor_from_first_ * first->cam_from_world();
-  recovered = localize_backwards(frames_to_retry_, later, retry_step_, map_->map_points(), options_.pose);
+  // The last retry skips frames that fail (people hiding the view for a moment) as long as it finds one
+  // again within kRetryMaxGapS: the frames are not tried again after it.
+  const bool last_retry = retries_before_init_ >= std::size(kRetryKeyframes);
+  recovered = localize_backwards(frames_to_retry_, later, retry_step_, map_->map_points(), options_.pose,
+                                 last_retry ? kRetryMaxGapS : 0.0);
   retry_anchor_from_first_ = later * first->world_from_cam();
-  if (retries_before_init_ >= std::size(kRetryKeyframes)) frames_to_retry_.clear();
+  if (last_retry) frames_to_retry_.clear();
   if (frames_to_retry_.empty()) retry_first_keyframe_.reset();
   std::sort(recovered.begin(), recovered.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
