@@ -8,6 +8,7 @@
 #include <cmath>
 #include <ctime>
 #include <filesystem>
+#include <unordered_set>
 
 #include "crowdslam/eval/ate.h"
 #include "crowdslam/eval/rpe.h"
@@ -109,11 +110,14 @@ nlohmann::json ground_json(const system::System& slam) {
 
 void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummary& summary) {
   std::vector<double> tracking_ms, extraction_ms, total_ms;
+  // Bridged frames a monocular re-anchoring localised afterwards are tracked, not bridged.
+  std::unordered_set<size_t> localized_later;
+  for (const auto& r : reports) localized_later.insert(r.localized_after_reanchor.begin(), r.localized_after_reanchor.end());
   for (const auto& r : reports) {
     if (!summary.init_frame && r.method == std::string("init")) summary.init_frame = r.index;
     summary.frames_localized_before_init += r.localized_before_init.size();
     summary.frames_localized_after_reanchor += r.localized_after_reanchor.size();
-    if (r.state == tracking::TrackingState::kBridged) ++summary.bridged;
+    if (r.state == tracking::TrackingState::kBridged && !localized_later.count(r.index)) ++summary.bridged;
     tracking_ms.push_back(r.tracking_ms);
     extraction_ms.push_back(r.extraction_ms);
     total_ms.push_back(r.extraction_ms + r.detector_wait_ms + r.tracking_ms);

@@ -84,7 +84,7 @@ FramePoses localize_backwards(std::deque<map::Frame>& frames, geometry::SE3& lat
 AroundTwoViews localize_around_two_views(std::deque<map::Frame> frames, uint64_t reference_id,
                                          const geometry::SE3& first_pose, double t0, const geometry::SE3& last_pose,
                                          double t1, const std::vector<std::shared_ptr<map::MapPoint>>& points,
-                                         const optim::PoseOptimizerOptions& options) {
+                                         const optim::PoseOptimizerOptions& options, double max_gap_s) {
   AroundTwoViews out;
   // Between the reference frame and the second view.
   for (const auto& frame : frames) {
@@ -104,7 +104,7 @@ AroundTwoViews localize_around_two_views(std::deque<map::Frame> frames, uint64_t
     const double t = (out.left.back().timestamp_s - t0) / (t1 - t0);
     out.step = interpolate_pose(first_pose, last_pose, std::max(t, -1.0)) * first_pose.inverse();
   }
-  const auto before = localize_backwards(out.left, out.later, out.step, points, options);
+  const auto before = localize_backwards(out.left, out.later, out.step, points, options, max_gap_s);
   out.recovered.insert(out.recovered.end(), before.begin(), before.end());
   std::sort(out.recovered.begin(), out.recovered.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });

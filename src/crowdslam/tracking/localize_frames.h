@@ -48,7 +48,8 @@ FramePoses localize_backwards(std::deque<map::Frame>& frames, geometry::SE3& lat
 // by interpolating in time between the two; those before it, newest first, backwards from the reference
 // by the motion between the two views extrapolated to the frame before. Frames between the views that
 // fail are dropped; those before the reference that fail stay in `left` (oldest first), with `later` and
-// `step` where localize_backwards would go on from.
+// `step` where localize_backwards would go on from (`max_gap_s` as there: with a gap, `left` is not for
+// going on from).
 struct AroundTwoViews {
   FramePoses recovered;  // sorted by frame id
   std::deque<map::Frame> left;
@@ -58,6 +59,6 @@ struct AroundTwoViews {
 AroundTwoViews localize_around_two_views(std::deque<map::Frame> frames, uint64_t reference_id,
                                          const geometry::SE3& first_pose, double t0, const geometry::SE3& last_pose,
                                          double t1, const std::vector<std::shared_ptr<map::MapPoint>>& points,
-                                         const optim::PoseOptimizerOptions& options);
+                                         const optim::PoseOptimizerOptions& options, double max_gap_s = 0.0);
 
 }  // namespace crowdslam::tracking
