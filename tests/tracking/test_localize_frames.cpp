@@ -40,8 +40,8 @@ struct Scene {
     }
     // The map: every point observed by one keyframe at the pose of frame 10.
     std::vector<int> seen;
-    auto kf = std::make_shared<map::KeyFrame>(0, 10, 10 * kFrameS, camera, levels, observe(pose(10), 1.0, seen),
-                                              pose(10));
+    auto kf = std::make_shared<map::KeyFrame>(0, 10, 10 * kFrameS, camera, levels,
+                                              observe(pose(10), 1.0, seen), pose(10));
     for (size_t i = 0; i < points.size(); ++i) {
       if (seen[i] < 0) continue;
       auto p = std::make_shared<map::MapPoint>(i, points[i], kf, 10);
@@ -59,7 +59,8 @@ struct Scene {
 
   // Keypoints of the points visible from `cam_from_world`, each kept with probability `visible` (the rest
   // hidden by people), at the projection plus 0.3 px noise.
-  std::shared_ptr<map::FrameFeatures> observe(const SE3& cam_from_world, double visible, std::vector<int>& seen) {
+  std::shared_ptr<map::FrameFeatures> observe(const SE3& cam_from_world, double visible,
+                                              std::vector<int>& seen) {
     auto f = std::make_shared<map::FrameFeatures>();
     std::normal_distribution<float> noise(0.0f, 0.3f);
     std::uniform_real_distribution<double> keep(0.0, 1.0);
@@ -71,15 +72,17 @@ struct Scene {
       if (c.z() <= 0.1 || px.x() < 0 || px.x() >= 640 || px.y() < 0 || px.y() >= 480) continue;
       if (keep(rng) >= visible) continue;
       seen[i] = static_cast<int>(f->keys.size());
-      f->keys.emplace_back(cv::Point2f(static_cast<float>(px.x()) + noise(rng), static_cast<float>(px.y()) + noise(rng)),
-                           31, 45.0f, 1, 0);
+      f->keys.emplace_back(
+          cv::Point2f(static_cast<float>(px.x()) + noise(rng), static_cast<float>(px.y()) + noise(rng)), 31,
+          45.0f, 1, 0);
       f->depth_m.push_back(-1);
       f->right_u.push_back(-1);
       desc.push_back(descriptors[i]);
     }
     f->keys_un = f->keys;
     f->descriptors = cv::Mat(static_cast<int>(desc.size()), 32, CV_8UC1);
-    for (size_t i = 0; i < desc.size(); ++i) std::memcpy(f->descriptors.ptr(static_cast<int>(i)), desc[i].data(), 32);
+    for (size_t i = 0; i < desc.size(); ++i)
+      std::memcpy(f->descriptors.ptr(static_cast<int>(i)), desc[i].data(), 32);
     f->grid = map::FeatureGrid(f->keys_un, camera->undistorted_bounds());
     return f;
   }
@@ -90,7 +93,8 @@ struct Scene {
     for (int k = 0; k < 10; ++k) {
       const bool is_hidden = std::find(hidden.begin(), hidden.end(), k) != hidden.end();
       std::vector<int> seen;
-      out.emplace_back(static_cast<uint64_t>(k), k * kFrameS, camera, levels, observe(pose(k), is_hidden ? 0.03 : 1.0, seen));
+      out.emplace_back(static_cast<uint64_t>(k), k * kFrameS, camera, levels,
+                       observe(pose(k), is_hidden ? 0.03 : 1.0, seen));
     }
     return out;
   }

@@ -61,8 +61,9 @@ double estimate_person_depth(const cv::Mat& depth_image_raw, double depth_factor
   if (region.area() <= 0) return -1.0;
   std::vector<uint16_t> values = sample_valid_depths(depth_image_raw, region, 2000);
   if (values.size() < 10) return -1.0;
-  const double q = std::clamp(quantile, 0.0, 1.0);
-  const auto nth = values.begin() + std::min(static_cast<long>(values.size() * q), static_cast<long>(values.size()) - 1);
+  const auto last = static_cast<long>(values.size()) - 1;
+  const auto nth =
+      values.begin() + std::min(static_cast<long>(values.size() * std::clamp(quantile, 0.0, 1.0)), last);
   std::nth_element(values.begin(), nth, values.end());
   return *nth / depth_factor;
 }

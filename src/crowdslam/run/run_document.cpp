@@ -112,7 +112,9 @@ void summarise_frames(const std::vector<system::FrameReport>& reports, RunSummar
   std::vector<double> tracking_ms, extraction_ms, total_ms;
   // Bridged frames a monocular re-anchoring localised afterwards are tracked, not bridged.
   std::unordered_set<size_t> localized_later;
-  for (const auto& r : reports) localized_later.insert(r.localized_after_reanchor.begin(), r.localized_after_reanchor.end());
+  for (const auto& r : reports) {
+    localized_later.insert(r.localized_after_reanchor.begin(), r.localized_after_reanchor.end());
+  }
   for (const auto& r : reports) {
     if (!summary.init_frame && r.method == std::string("init")) summary.init_frame = r.index;
     summary.frames_localized_before_init += r.localized_before_init.size();

@@ -82,8 +82,9 @@ FramePoses localize_backwards(std::deque<map::Frame>& frames, geometry::SE3& lat
 }
 
 AroundTwoViews localize_around_two_views(std::deque<map::Frame> frames, uint64_t reference_id,
-                                         const geometry::SE3& first_pose, double t0, const geometry::SE3& last_pose,
-                                         double t1, const std::vector<std::shared_ptr<map::MapPoint>>& points,
+                                         const geometry::SE3& first_pose, double t0,
+                                         const geometry::SE3& last_pose, double t1,
+                                         const std::vector<std::shared_ptr<map::MapPoint>>& points,
                                          const optim::PoseOptimizerOptions& options, double max_gap_s) {
   AroundTwoViews out;
   // Between the reference frame and the second view.

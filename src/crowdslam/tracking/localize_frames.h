@@ -33,12 +33,16 @@ std::optional<geometry::SE3> localize_in_map(map::Frame frame, const geometry::S
                                              const std::vector<std::shared_ptr<map::MapPoint>>& points,
                                              const optim::PoseOptimizerOptions& options);
 
+// The longest run of failing frames a last pass over frames localised afterwards skips (people in front of
+// the camera for a moment): the last retry before a monocular initialisation, and a re-anchoring.
+inline constexpr double kLocalizeMaxGapS = 0.5;
+
 // Frames before `later` (newest last in `frames`, which keeps those that fail), each from the pose of the
 // frame after it moved by the last measured step. `step` is cam_from_world(earlier) * world_from_cam(later)
 // for one frame interval, as last measured. Stops at a failure more than `max_gap_s` before the last frame
 // localised (0: at the first failure); a failed frame within that is skipped, and the frame before it is
-// guessed on by the same step from where the failed one was guessed. On return `later` and `step` are those of the oldest frame
-// localised; `frames` holds, oldest first, the frames not tried and those skipped.
+// guessed on by the same step from where the failed one was guessed. On return `later` and `step` are
+// those of the oldest frame localised; `frames` holds, oldest first, the frames not tried and those skipped.
 FramePoses localize_backwards(std::deque<map::Frame>& frames, geometry::SE3& later, geometry::SE3& step,
                               const std::vector<std::shared_ptr<map::MapPoint>>& points,
                               const optim::PoseOptimizerOptions& options, double max_gap_s = 0.0);
@@ -57,8 +61,9 @@ struct AroundTwoViews {
   geometry::SE3 step;
 };
 AroundTwoViews localize_around_two_views(std::deque<map::Frame> frames, uint64_t reference_id,
-                                         const geometry::SE3& first_pose, double t0, const geometry::SE3& last_pose,
-                                         double t1, const std::vector<std::shared_ptr<map::MapPoint>>& points,
+                                         const geometry::SE3& first_pose, double t0,
+                                         const geometry::SE3& last_pose, double t1,
+                                         const std::vector<std::shared_ptr<map::MapPoint>>& points,
                                          const optim::PoseOptimizerOptions& options, double max_gap_s = 0.0);
 
 }  // namespace crowdslam::tracking

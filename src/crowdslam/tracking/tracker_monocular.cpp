@@ -85,7 +85,6 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
 std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_init() {
   // Tried when the map has this many keyframes (the two-view map's keyframes are the first two).
   constexpr size_t kRetryKeyframes[] = {4, 8};
-  constexpr double kRetryMaxGapS = 0.5;
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
   if (frames_to_retry_.empty() || retries_before_init_ >= std::size(kRetryKeyframes) ||
       map_->num_keyframes() < kRetryKeyframes[retries_before_init_]) {
@@ -101,10 +100,10 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_ini
   }
   geometry::SE3 later = retry_anchor_from_first_ * first->cam_from_world();
   // The last retry skips frames that fail (people hiding the view for a moment) as long as it finds one
-  // again within kRetryMaxGapS: the frames are not tried again after it.
+  // again within kLocalizeMaxGapS: the frames are not tried again after it.
   const bool last_retry = retries_before_init_ >= std::size(kRetryKeyframes);
   recovered = localize_backwards(frames_to_retry_, later, retry_step_, map_->map_points(), options_.pose,
-                                 last_retry ? kRetryMaxGapS : 0.0);
+                                 last_retry ? kLocalizeMaxGapS : 0.0);
   retry_anchor_from_first_ = later * first->world_from_cam();
   if (last_retry) frames_to_retry_.clear();
   if (frames_to_retry_.empty()) retry_first_keyframe_.reset();

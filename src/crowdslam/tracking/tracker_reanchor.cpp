@@ -15,7 +15,6 @@ namespace crowdslam::tracking {
 
 namespace {
 constexpr double kReanchorPriorS = 1.0;
-constexpr double kLostMaxGapS = 0.5;  // lost frames localised afterwards: the longest run of failures skipped
 }  // namespace
 
 MonocularInitializerOptions reanchor_initializer_options(MonocularInitializerOptions options) {
@@ -126,10 +125,10 @@ bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
   track_from_two_views(first, second, frame, second->valid_map_points());
   frame.discard_outliers();
   // The frames lost before: between the two views, and before the first (backwards from it, skipping
-  // those that fail as long as one is localised again within kLostMaxGapS; they are not tried again).
-  auto around = localize_around_two_views(std::move(frames_since_loss_), first->frame_id, first->cam_from_world(),
-                                          first->timestamp_s, *frame.cam_from_world, frame.timestamp_s,
-                                          map_->map_points(), options_.pose, kLostMaxGapS);
+  // those that fail as long as one is localised again within kLocalizeMaxGapS; they are not tried again).
+  auto around = localize_around_two_views(
+      std::move(frames_since_loss_), first->frame_id, first->cam_from_world(), first->timestamp_s,
+      *frame.cam_from_world, frame.timestamp_s, map_->map_points(), options_.pose, kLocalizeMaxGapS);
   frames_since_loss_.clear();
   result.recovered = std::move(around.recovered);
   result.recovered.emplace_back(first->frame_id, first->cam_from_world());
