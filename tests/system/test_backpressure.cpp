@@ -5,6 +5,13 @@
 // initialisation on is tracked and some frames record the wait; without it (max wait 0, ORB-SLAM2's
 // behaviour) the same slow mapper costs keyframes.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
 
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/io/settings.h"
@@ -80,4 +87,59 @@ TEST(Backpressure, SlowMapperMakesTrackingWaitInsteadOfGoingOnWithoutKeyframes) 
   EXPECT_GT(waiting.frames_waited, 0);
   EXPECT_EQ(ignoring.frames_waited, 0);
   EXPECT_GT(waiting.keyframes, ignoring.keyframes);  // without waiting the slow mapper cost keyframes
+}
+
+// Local mapping runs SystemOptions::background_nice nicer than tracking (util/thread_priority.h): the
+// named thread's nice value, read from /proc while the system runs.
+namespace {
+// Nice value of this process's thread named `name` (-100 if there is none): field 19 of
+// /proc/self/task/TID/stat, counted after the command name's closing parenthesis.
+int nice_of_thread(const std::string& name) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string task_name;
+    std::getline(comm, task_name);
+    if (task_name != name) continue;
+    std::ifstream stat(task.path() / "stat");
+    const std::string line((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    std::istringstream rest(line.substr(line.rfind(')') + 2));
+    std::string field;
+    for (int i = 3; i <= 19 && rest >> field; ++i) {
+    }
+    return std::stoi(field);
+  }
+  return -100;
+}
+
+int mapper_nice(const std::filesystem::path& seq, int background_nice) {
+  auto dataset = io::open_dataset(seq.string());
+  const io::Settings settings = io::load_settings((seq / "settings.yaml").string(), io::SensorKind::kRgbd);
+  system::SystemOptions options;
+  options.people_filter = false;
+  options.vocabulary_path = "none";
+  options.loop_closing = false;
+  options.background_nice = background_nice;
+  system::System slam(settings, options);
+  for (int i = 0; i < 3; ++i) {
+    auto frame = dataset->next();
+    slam.track(frame->images, frame->info.timestamp_s);
+  }
+  const int nice = nice_of_thread("cs-mapper");
+  slam.shutdown();
+  return nice;
+}
+}  // namespace
+
+TEST(BackgroundThreads, LocalMappingRunsNicerThanTracking) {
+  test::TempDir tmp;
+  synth::SynthOptions synth_options;
+  synth_options.frames = 3;
+  synth_options.width = 320;
+  synth_options.height = 240;
+  synth_options.people = 0;
+  synth::write_sequence(synth_options, tmp / "seq");
+  const int own = getpriority(PRIO_PROCESS, 0);
+  EXPECT_EQ(mapper_nice(tmp / "seq", 7), std::min(19, own + 7));
+  EXPECT_EQ(mapper_nice(tmp / "seq", 0), own);
+  EXPECT_EQ(nice_of_thread("cs-mapper"), -100);  // joined by shutdown
 }

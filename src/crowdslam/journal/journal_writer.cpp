@@ -11,6 +11,7 @@
 #include "crowdslam/util/atomic_file.h"
 #include "crowdslam/util/error.h"
 #include "crowdslam/util/text.h"
+#include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::journal {
 
@@ -39,7 +40,10 @@ JournalWriter::JournalWriter(JournalWriterOptions options) : options_(std::move(
       throw input_error(clip_text(options_.frames_dir.string()), "cannot create directory: " + ec.message());
     }
   }
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    util::set_thread_name("cs-journal");
+    run();
+  });
 }
 
 JournalWriter::~JournalWriter() {

@@ -10,6 +10,7 @@
 
 #include "crowdslam/map/keyframe.h"
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::loop {
 
@@ -29,6 +30,7 @@ void GlobalBundleAdjuster::launch() {
   abort_ = false;
   running_ = true;
   worker_ = std::thread([this] {
+    util::set_thread_name("cs-global-ba");
     optimise_and_apply();
     running_ = false;
   });

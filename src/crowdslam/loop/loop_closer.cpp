@@ -11,6 +11,7 @@
 #include "crowdslam/match/bow_search.h"
 #include "crowdslam/optim/sim3_optimization.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::loop {
 
@@ -51,7 +52,11 @@ void LoopCloser::start() {
     std::lock_guard lock(queue_mutex_);
     stop_requested_ = false;
   }
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this] {
+    util::set_thread_name("cs-loop");
+    util::lower_thread_priority(options_.thread_nice);
+    run();
+  });
 }
 
 void LoopCloser::stop() {

@@ -54,6 +54,9 @@ struct LoopCloserOptions {
   int global_ba_iterations = 10;
   // Monocular on a vehicle (io::GroundSettings): global BA also holds the ground under each keyframe.
   std::optional<geometry::GroundPlaneOptions> ground;
+  // The loop closing thread's nice value above the creator's (util/thread_priority.h); the global BA
+  // thread it starts inherits it.
+  int thread_nice = 0;
   void check() const;
 };
 

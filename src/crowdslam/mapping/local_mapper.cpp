@@ -9,6 +9,7 @@
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::mapping {
 
@@ -38,6 +39,8 @@ void LocalMapper::start() {
     worker_active_ = true;
   }
   worker_ = std::thread([this] {
+    util::set_thread_name("cs-mapper");
+    util::lower_thread_priority(options_.thread_nice);
     run();
     std::lock_guard lock(queue_mutex_);
     worker_active_ = false;

@@ -43,6 +43,7 @@ struct LocalMapperOptions {
   double odometry_sigma_deg = 0;
   optim::BundleAdjustmentOptions ba;
   double delay_ms = 0;  // experiments and tests: sleep this long per keyframe (an artificially slow mapper)
+  int thread_nice = 0;  // the mapper thread's nice value above the creator's (util/thread_priority.h)
   void check() const;
 };
 

@@ -5,10 +5,15 @@
 #include <string>
 #include <utility>
 
+#include "crowdslam/util/thread_priority.h"
+
 namespace crowdslam::people {
 
 DetectionWorker::DetectionWorker(std::unique_ptr<PersonDetector> detector)
-    : detector_(std::move(detector)), thread_([this] { run(); }) {}
+    : detector_(std::move(detector)), thread_([this] {
+        util::set_thread_name("cs-detector");
+        run();
+      }) {}
 
 DetectionWorker::~DetectionWorker() {
   {

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "crowdslam/util/error.h"
+#include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::run {
 
@@ -11,7 +12,10 @@ FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_
       capacity_(std::max<size_t>(1, capacity)),
       max_frames_(max_frames),
       skip_bad_frames_(skip_bad_frames && dynamic_cast<io::Dataset*>(&source) != nullptr) {
-  reader_ = std::thread([this] { run(); });
+  reader_ = std::thread([this] {
+    util::set_thread_name("cs-reader");
+    run();
+  });
 }
 
 FramePrefetcher::~FramePrefetcher() {

@@ -253,6 +253,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
   doc.erase("pid");
   doc["end_state"] = summary.end.to_string();
   doc["finished"] = utc_now();
+  doc["background_nice"] = c.options.background_nice;  // threaded mode: mapping and loop closing
   if (const auto& vocabulary = slam.vocabulary_info()) {
     doc["vocabulary"] = {
         {"path", vocabulary->path}, {"words", vocabulary->words}, {"load_ms", vocabulary->load_ms}};

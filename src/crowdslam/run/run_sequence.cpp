@@ -66,6 +66,7 @@ system::SystemOptions system_options(const RunOptions& options, io::SensorKind s
   s.record_keypoints = options.save_frames > 0 || options.viewer;  // drawn by the journal / the viewer
   s.vocabulary_path = options.vocabulary;
   s.loop_closing = options.loop_closing;
+  s.background_nice = options.background_nice;
   s.replay_waits_for_mapping = !options.pace_sensor;  // a paced replay is a live camera: it does not wait
   return s;
 }

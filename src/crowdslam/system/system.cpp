@@ -68,6 +68,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   mapper_options.monocular = options.sensor == io::SensorKind::kMonocular;
   mapper_options.close_depth_m = close_depth_m;
   mapper_options.delay_ms = options.mapper_delay_ms;
+  mapper_options.thread_nice = options.background_nice;
   // Part of keeping people out, as the feature budget: the static-world baseline (--no-people-filter) runs
   // without it, as ORB-SLAM. There tracking follows whatever moves, and its relative poses would only pass
   // that on (docs/CROWDS.md#keyframes-that-see-a-strip-of-background).
@@ -127,6 +128,7 @@ System::System(const io::Settings& settings, const SystemOptions& options)
       loop::LoopCloserOptions loop_options;
       loop_options.fix_scale = options.sensor != io::SensorKind::kMonocular;
       loop_options.ground = ground_;
+      loop_options.thread_nice = options.background_nice;
       loop_closer_ = std::make_unique<loop::LoopCloser>(loop_options, map_, keyframe_database_.get(), mapper_.get());
       mapper_->set_keyframe_done(
           [closer = loop_closer_.get()](const std::shared_ptr<map::KeyFrame>& keyframe) { closer->insert_keyframe(keyframe); });

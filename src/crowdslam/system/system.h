@@ -53,6 +53,9 @@ struct SystemOptions {
   bool replay_waits_for_mapping = true;
   // Experiments and tests only: local mapping sleeps this long per keyframe (a slow mapper on demand).
   double mapper_delay_ms = 0;
+  // Local mapping and loop closing run this much nicer than tracking (0-19; 0 = the same priority), so
+  // the frame's path gets the cores first when every thread is busy (util/thread_priority.h).
+  int background_nice = 10;
 };
 
 // The vocabulary a System loaded, for run.json.

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::viewer {
 
@@ -17,7 +18,10 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 ViewerObserver::ViewerObserver(EventStream& stream, const RunControl* control, ViewerObserverOptions options)
     : stream_(stream), control_(control), options_(std::move(options)) {
   fps_start_ = std::chrono::steady_clock::now();
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this] {
+    util::set_thread_name("cs-viewer");
+    run();
+  });
 }
 
 ViewerObserver::~ViewerObserver() { stop(); }
