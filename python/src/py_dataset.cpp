@@ -51,9 +51,12 @@ class PySequence {
       if (generation != generation_ || !prefetcher_) {
         throw std::runtime_error(source_->path() + ": this iterator is stale (the sequence was iterated again)");
       }
-      auto frame = prefetcher_->next();
-      if (!frame) prefetcher_.reset();
-      return frame;
+      auto prefetched = prefetcher_->next();
+      if (!prefetched) {
+        prefetcher_.reset();
+        return std::optional<io::Frame>();
+      }
+      return std::optional<io::Frame>(std::move(prefetched->frame));
     });
   }
 

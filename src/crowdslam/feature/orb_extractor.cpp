@@ -84,16 +84,17 @@ void ORBExtractor::share_budget(int num_features, std::vector<int>& counts) cons
   counts[levels - 1] = num_features - assigned;
 }
 
-void ORBExtractor::build_pyramid(const cv::Mat& gray) {
-  pyramid_[0] = gray;
+void ORBExtractor::build_pyramid(const cv::Mat& gray, std::vector<cv::Mat>& pyramid) const {
+  pyramid.resize(static_cast<std::size_t>(options_.num_levels));
+  pyramid[0] = gray;
   for (int level = 1; level < options_.num_levels; ++level) {
     const float inv_scale = inv_scale_factors_[level];
     const cv::Size size(cvRound(gray.cols * inv_scale), cvRound(gray.rows * inv_scale));
-    if (size.width < 1 || size.height < 1 || pyramid_[level - 1].empty()) {
-      pyramid_[level].release();
+    if (size.width < 1 || size.height < 1 || pyramid[level - 1].empty()) {
+      pyramid[level].release();
       continue;
     }
-    cv::resize(pyramid_[level - 1], pyramid_[level], size, 0, 0, cv::INTER_LINEAR);
+    cv::resize(pyramid[level - 1], pyramid[level], size, 0, 0, cv::INTER_LINEAR);
   }
 }
 
@@ -145,18 +146,56 @@ void ORBExtractor::detect_fast_grid(const cv::Mat& image, const cv::Rect& area,
   }
 }
 
-void ORBExtractor::detect_level(int level, int target, std::vector<cv::KeyPoint>& keypoints) {
-  keypoints.clear();
-  const cv::Mat& image = pyramid_[level];
-  if (image.empty() || target <= 0) return;
-  // FAST runs on [border, size - border) and finds corners 3 pixels further in, so every keypoint is
-  // kOrbEdgeThreshold pixels inside the level: the orientation and descriptor patches fit.
+namespace {
+void check_gray(const cv::Mat& gray) {
+  if (gray.empty()) throw InputError("ORB extractor: empty image");
+  if (gray.type() != CV_8UC1) {
+    throw InputError("ORB extractor: image must be 8-bit gray (CV_8UC1), got type " +
+                     std::to_string(gray.type()) + " with " + std::to_string(gray.channels()) + " channels");
+  }
+}
+
+// FAST runs on [border, size - border) and finds corners 3 pixels further in, so every keypoint is
+// kOrbEdgeThreshold pixels inside the level: the orientation and descriptor patches fit.
+cv::Rect detection_area(const cv::Mat& image) {
   const int border = kOrbEdgeThreshold - kFastRadius;
-  const cv::Rect area(border, border, image.cols - 2 * border, image.rows - 2 * border);
+  return {border, border, image.cols - 2 * border, image.rows - 2 * border};
+}
+}  // namespace
+
+void ORBExtractor::prepare(const cv::Mat& gray, PreparedImage& out) {
+  check_gray(gray);
+  const auto levels = static_cast<std::size_t>(options_.num_levels);
+  out.gray = gray;
+  build_pyramid(gray, out.pyramid);
+  out.blurred.resize(levels);
+  out.corners.resize(levels);
+  for (std::size_t level = 0; level < levels; ++level) {
+    const cv::Mat& image = out.pyramid[level];
+    out.corners[level].clear();
+    if (image.empty()) {
+      out.blurred[level].release();
+      continue;
+    }
+    const cv::Rect area = detection_area(image);
+    if (area.width >= kFastMinSide && area.height >= kFastMinSide) {
+      detect_fast_grid(image, area, out.corners[level]);
+    }
+    // BORDER_ISOLATED keeps OpenCV on its bit-exact fixed-point path even when `gray` is a view.
+    cv::GaussianBlur(image, out.blurred[level], cv::Size(7, 7), 2, 2,
+                     cv::BORDER_REFLECT_101 | cv::BORDER_ISOLATED);
+  }
+}
+
+void ORBExtractor::distribute_level(const PreparedImage& prepared, int level, int target,
+                                    std::vector<cv::KeyPoint>& keypoints) {
+  keypoints.clear();
+  const cv::Mat& image = prepared.pyramid[level];
+  if (image.empty() || target <= 0) return;
+  const cv::Rect area = detection_area(image);
   if (area.width < kFastMinSide || area.height < kFastMinSide) return;
 
-  candidates_.clear();
-  detect_fast_grid(image, area, candidates_);
+  candidates_ = prepared.corners[level];  // the distributor reorders its input
   distributor_.distribute(candidates_, cv::Rect2f(area), target, keypoints);
 
   const float size = static_cast<float>(kOrbPatchSize) * scale_factors_[level];
@@ -169,34 +208,38 @@ void ORBExtractor::detect_level(int level, int target, std::vector<cv::KeyPoint>
 
 void ORBExtractor::extract(const cv::Mat& gray, int num_features, std::vector<cv::KeyPoint>& keypoints,
                            cv::Mat& descriptors) {
-  if (gray.empty()) throw InputError("ORB extractor: empty image");
-  if (gray.type() != CV_8UC1) {
-    throw InputError("ORB extractor: image must be 8-bit gray (CV_8UC1), got type " +
-                     std::to_string(gray.type()) + " with " + std::to_string(gray.channels()) + " channels");
+  prepare(gray, prepared_);
+  extract(prepared_, num_features, keypoints, descriptors);
+}
+
+void ORBExtractor::extract(const PreparedImage& prepared, int num_features, std::vector<cv::KeyPoint>& keypoints,
+                           cv::Mat& descriptors) {
+  check_gray(prepared.gray);
+  if (prepared.pyramid.size() != static_cast<std::size_t>(options_.num_levels) ||
+      prepared.blurred.size() != prepared.pyramid.size() || prepared.corners.size() != prepared.pyramid.size()) {
+    throw InputError("ORB extractor: the prepared image has " + std::to_string(prepared.pyramid.size()) +
+                     " levels, the extractor " + std::to_string(options_.num_levels));
   }
   assert(num_features >= 0);
-  build_pyramid(gray);
+  pyramid_ = prepared.pyramid;
 
   share_budget(std::max(num_features, 0), level_targets_);
   std::size_t total = 0;
   for (int level = 0; level < options_.num_levels; ++level) {
-    detect_level(level, level_targets_[level], level_keypoints_[level]);
+    distribute_level(prepared, level, level_targets_[level], level_keypoints_[level]);
     total += level_keypoints_[level].size();
   }
 
   keypoints.clear();
   keypoints.reserve(total);
   descriptors.create(static_cast<int>(total), kDescriptorBytes, CV_8UC1);
+  const cv::Mat& gray = prepared.gray;
   int row = 0;
   for (int level = 0; level < options_.num_levels; ++level) {
     std::vector<cv::KeyPoint>& level_keypoints = level_keypoints_[level];
     if (level_keypoints.empty()) continue;
-    // One buffer of level-0 size, viewed at each level's size: no reallocation between levels.
     const cv::Mat& image = pyramid_[level];
-    blurred_.create(gray.size(), CV_8UC1);
-    cv::Mat blurred = blurred_(cv::Rect(0, 0, image.cols, image.rows));
-    // BORDER_ISOLATED keeps OpenCV on its bit-exact fixed-point path even when `gray` is a view.
-    cv::GaussianBlur(image, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101 | cv::BORDER_ISOLATED);
+    const cv::Mat& blurred = prepared.blurred[level];
     // Level -> level-0 pixel coordinates with pixel centres at integers. cv::resize (INTER_LINEAR)
     // aligns pixel centres, so the exact map is x0 = (x + 0.5) * (w0 / w) - 0.5; ORB-SLAM's x0 = x * s
     // puts level-l keypoints up to 0.5 (s_l - 1) px (1.3 px at level 7) up and to the left.

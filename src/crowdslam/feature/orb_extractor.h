@@ -18,7 +18,13 @@
 //  - when the quadtree's last split overshoots a level's target, that split's weakest children are
 //    dropped, so a level never returns more than its share and the total never exceeds the budget.
 //
-// One extractor per thread: extract() reuses the pyramid and scratch buffers between frames, so it is
+// Extraction runs in two steps. prepare() does what does not depend on the feature budget: the pyramid,
+// every level's FAST corners and its Gaussian-blurred copy for the descriptors (two thirds of the work).
+// extract() from a PreparedImage distributes the corners to the budget, orients them and computes their
+// descriptors. The run's reader thread prepares the next frames while tracking works on this one
+// (System::prepare); extract(gray, ...) does both steps here. Either way the result is the same.
+//
+// One extractor per thread: extract() and prepare() reuse scratch buffers between frames, so they are
 // not reentrant, but separate extractors share nothing.
 #include <opencv2/core.hpp>
 #include <vector>
@@ -26,6 +32,14 @@
 #include "crowdslam/feature/quadtree.h"
 
 namespace crowdslam::feature {
+
+// What ORBExtractor::prepare() computed for one image (valid with an extractor of the same options).
+struct PreparedImage {
+  cv::Mat gray;                                  // the image (level 0 shares its data)
+  std::vector<cv::Mat> pyramid;                  // per level; levels too small to exist are empty
+  std::vector<cv::Mat> blurred;                  // per level, GaussianBlur 7x7, sigma 2 (for BRIEF)
+  std::vector<std::vector<cv::KeyPoint>> corners;  // per level, FAST corners in level coordinates
+};
 
 class ORBExtractor {
  public:
@@ -51,6 +65,12 @@ class ORBExtractor {
   void extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) {
     extract(gray, options_.num_features, keypoints, descriptors);
   }
+  // The budget-independent step for `gray` (same errors as extract()), into `out` (its buffers reused).
+  void prepare(const cv::Mat& gray, PreparedImage& out);
+  // The rest, from what an extractor with the same options prepared (throws InputError if the number
+  // of levels differs). `prepared` is not changed; pyramid() then shares its levels.
+  void extract(const PreparedImage& prepared, int num_features, std::vector<cv::KeyPoint>& keypoints,
+               cv::Mat& descriptors);
 
   const Options& options() const { return options_; }
   int num_levels() const { return options_.num_levels; }
@@ -72,9 +92,10 @@ class ORBExtractor {
 
  private:
   void share_budget(int num_features, std::vector<int>& counts) const;
-  void build_pyramid(const cv::Mat& gray);
-  // Keypoints of one level in level coordinates, already distributed and oriented.
-  void detect_level(int level, int target, std::vector<cv::KeyPoint>& keypoints);
+  void build_pyramid(const cv::Mat& gray, std::vector<cv::Mat>& pyramid) const;
+  // Keypoints of one level in level coordinates, distributed from `corners` and oriented.
+  void distribute_level(const PreparedImage& prepared, int level, int target,
+                        std::vector<cv::KeyPoint>& keypoints);
   // FAST corners of `area` (level coordinates) at ini_th_fast, and at min_th_fast in grid cells where
   // ini_th_fast found none. Replaces the contents of `out`.
   void detect_fast_grid(const cv::Mat& image, const cv::Rect& area, std::vector<cv::KeyPoint>& out);
@@ -86,7 +107,7 @@ class ORBExtractor {
   std::vector<float> inv_level_sigma2_;
 
   std::vector<cv::Mat> pyramid_;
-  cv::Mat blurred_;
+  PreparedImage prepared_;  // extract(gray, ...)'s own
   std::vector<int> level_targets_;
   std::vector<std::vector<cv::KeyPoint>> level_keypoints_;
   std::vector<cv::KeyPoint> candidates_;

@@ -7,11 +7,13 @@
 
 namespace crowdslam::run {
 
-FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames, bool skip_bad_frames)
+FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames, bool skip_bad_frames,
+                                 Prepare prepare)
     : source_(source),
       capacity_(std::max<size_t>(1, capacity)),
       max_frames_(max_frames),
-      skip_bad_frames_(skip_bad_frames && dynamic_cast<io::Dataset*>(&source) != nullptr) {
+      skip_bad_frames_(skip_bad_frames && dynamic_cast<io::Dataset*>(&source) != nullptr),
+      prepare_(std::move(prepare)) {
   reader_ = std::thread([this] {
     util::set_thread_name("cs-reader");
     run();
@@ -64,9 +66,19 @@ void FramePrefetcher::run() {
       break;
     }
     if (!frame) break;
+    std::shared_ptr<const feature::PreparedImage> prepared;
+    if (prepare_) {
+      try {
+        prepared = prepare_(frame->images);
+      } catch (...) {
+        std::lock_guard lock(mutex_);
+        error_ = std::current_exception();
+        break;
+      }
+    }
     {
       std::lock_guard lock(mutex_);
-      queue_.push_back(std::move(*frame));
+      queue_.push_back(PrefetchedFrame{std::move(*frame), std::move(prepared)});
     }
     ++produced;
     not_empty_.notify_one();
@@ -78,11 +90,11 @@ void FramePrefetcher::run() {
   not_empty_.notify_all();
 }
 
-std::optional<io::Frame> FramePrefetcher::next() {
+std::optional<PrefetchedFrame> FramePrefetcher::next() {
   std::unique_lock lock(mutex_);
   not_empty_.wait(lock, [this] { return !queue_.empty() || finished_; });
   if (!queue_.empty()) {
-    io::Frame frame = std::move(queue_.front());
+    PrefetchedFrame frame = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();
     not_full_.notify_one();

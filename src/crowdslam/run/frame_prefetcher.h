@@ -1,6 +1,7 @@
 #pragma once
 // Reads frames from a FrameSource on a background thread into a small bounded queue, so that image
-// decoding overlaps with tracking. End of stream and reader errors are delivered in order: next()
+// decoding overlaps with tracking. With a `prepare` function the same thread also does the budget-
+// independent part of each frame's ORB extraction (System::prepare), off the tracking thread. End of stream and reader errors are delivered in order: next()
 // returns nullopt at the end, and rethrows the reader's exception at the point where it happened.
 //
 // With `skip_bad_frames`, an InputError for one frame of a dataset on disk (which can go on to the next
@@ -8,11 +9,14 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 
+#include "crowdslam/feature/orb_extractor.h"
 #include "crowdslam/io/dataset.h"
 
 namespace crowdslam::run {
@@ -22,15 +26,22 @@ struct SkippedFrames {
   std::string first_error;  // the first skipped frame's error (names the file)
 };
 
+struct PrefetchedFrame {
+  io::Frame frame;
+  std::shared_ptr<const feature::PreparedImage> prepared;  // null without a prepare function, or refused
+};
+
 class FramePrefetcher {
  public:
-  // `source` must outlive the prefetcher. max_frames 0 = all.
-  FramePrefetcher(io::FrameSource& source, size_t capacity = 3, size_t max_frames = 0, bool skip_bad_frames = false);
+  using Prepare = std::function<std::shared_ptr<const feature::PreparedImage>(const io::FrameImages&)>;
+  // `source` (and what `prepare` uses) must outlive the prefetcher. max_frames 0 = all.
+  FramePrefetcher(io::FrameSource& source, size_t capacity = 3, size_t max_frames = 0, bool skip_bad_frames = false,
+                  Prepare prepare = {});
   ~FramePrefetcher();
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;
 
-  std::optional<io::Frame> next();
+  std::optional<PrefetchedFrame> next();
   // Stops reading ahead (interrupts); next() then returns what is queued, then nullopt.
   void cancel();
   [[nodiscard]] SkippedFrames skipped() const;
@@ -42,10 +53,11 @@ class FramePrefetcher {
   const size_t capacity_;
   const size_t max_frames_;
   const bool skip_bad_frames_;
+  const Prepare prepare_;
   mutable std::mutex mutex_;
   std::condition_variable not_empty_;
   std::condition_variable not_full_;
-  std::deque<io::Frame> queue_;
+  std::deque<PrefetchedFrame> queue_;
   bool finished_ = false;  // reader reached the end (or failed)
   bool cancelled_ = false;
   std::exception_ptr error_;

@@ -230,7 +230,9 @@ RunSummary run_sequence(const RunOptions& options) {
   std::exception_ptr error;
   const auto run_start = Clock::now();
   const size_t expected = p.source->summary().frames.value_or(0);
-  FramePrefetcher prefetcher(*p.source, 3, options.max_frames, options.skip_bad_frames);
+  // The reader thread also does the budget-independent part of each frame's extraction (System::prepare).
+  FramePrefetcher prefetcher(*p.source, 3, options.max_frames, options.skip_bad_frames,
+                             [&slam](const io::FrameImages& images) { return slam.prepare(images); });
   std::optional<SensorPacer> pacer;
   size_t dropped_after_tracking = 0;
   if (options.pace_sensor) pacer.emplace();
@@ -252,15 +254,16 @@ RunSummary run_sequence(const RunOptions& options) {
         if (interrupt_signal()) continue;  // handled at the top of the loop
       }
       const auto load_start = Clock::now();
-      auto frame = prefetcher.next();
-      if (!frame) break;
+      auto prefetched = prefetcher.next();
+      if (!prefetched) break;
+      io::Frame* frame = &prefetched->frame;
       load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - load_start).count());
       if (pacer && !pacer->admit(frame->info.timestamp_s)) {  // arrived while tracking was busy: dropped
         if (slam.tracked_frames() > 0) ++dropped_after_tracking;
         continue;
       }
       monitor.check_frame(*frame);
-      reports.push_back(slam.track(frame->images, frame->info.timestamp_s));
+      reports.push_back(slam.track(frame->images, frame->info.timestamp_s, prefetched->prepared.get()));
       auto& report = reports.back();
       monitor.after_tracking(*frame, report.keypoints_before_filter);
       // Drawn by the journal (it copied what it needs): run.json does not keep them.

@@ -227,7 +227,24 @@ std::string EndState::to_string() const {
   return "failed: " + reason;
 }
 
+std::shared_ptr<const feature::PreparedImage> System::prepare(const io::FrameImages& images) {
+  if (rectifier_ || images.colour.empty()) return nullptr;
+  if (!preparer_) preparer_ = std::make_unique<feature::ORBExtractor>(frame_builder_->orb_options());
+  auto prepared = std::make_shared<feature::PreparedImage>();
+  try {
+    preparer_->prepare(feature::to_gray(images.colour), *prepared);
+  } catch (const InputError&) {
+    return nullptr;  // track() reports it, in the frame's turn
+  }
+  return prepared;
+}
+
 FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
+  return track(images, timestamp_s, nullptr);
+}
+
+FrameReport System::track(const io::FrameImages& images, double timestamp_s,
+                          const feature::PreparedImage* prepared) {
   FrameReport report;
   report.index = next_frame_id_;
   report.timestamp_s = timestamp_s;
@@ -266,10 +283,15 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
     });
   }
   // The detector works on its own thread while ORB features are extracted here.
-  const cv::Mat gray = feature::to_gray(left_colour);
+  if (rectifier_) prepared = nullptr;  // prepared from the unrectified image
+  const cv::Mat gray = prepared ? prepared->gray : feature::to_gray(left_colour);
   if (people_) people_->begin_frame(frame_index, left_colour, gray);
   feature::RawFeatures raw;
-  frame_builder_->extract(gray, report.feature_budget, raw);
+  if (prepared) {
+    frame_builder_->extract(*prepared, report.feature_budget, raw);
+  } else {
+    frame_builder_->extract(gray, report.feature_budget, raw);
+  }
   report.keypoints_before_filter = static_cast<int>(raw.keys.size());
   if (stereo) {
     // Matched before the people filter, whose depth mode needs the keypoints' depths.

@@ -129,6 +129,14 @@ class System {
   // rectified here when the settings have LEFT/RIGHT blocks). Throws InputError for a missing right image.
   // Observers see the frame before track() returns.
   FrameReport track(const io::FrameImages& images, double timestamp_s);
+  // The same, with the left image's budget-independent extraction done ahead by prepare() (null: here).
+  FrameReport track(const io::FrameImages& images, double timestamp_s, const feature::PreparedImage* prepared);
+  // The part of a frame's ORB extraction that does not depend on the feature budget (pyramid, FAST
+  // corners, blurred levels: feature/orb_extractor.h), for track() to finish. Meant for the thread that
+  // reads the frames, while track() works on an earlier one: one caller thread at a time. Null when the
+  // frame is not prepared ahead (stereo with rectification, whose left image changes in track(), or an
+  // image the extractor refuses: track() then reports the error).
+  [[nodiscard]] std::shared_ptr<const feature::PreparedImage> prepare(const io::FrameImages& images);
   // Lets local mapping (and loop closing) finish their queues and stops their threads (idempotent; the
   // destructor calls it).
   void shutdown();
@@ -225,6 +233,7 @@ class System {
   std::unique_ptr<loop::LoopCloser> loop_closer_;              // with a vocabulary and loop closing on
   std::unique_ptr<tracking::FrameBuilder> frame_builder_;
   std::unique_ptr<geometry::StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
+  std::unique_ptr<feature::ORBExtractor> preparer_;        // prepare()'s, made at its first call
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   bool box_keypoints_ =

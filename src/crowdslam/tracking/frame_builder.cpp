@@ -30,6 +30,10 @@ void FrameBuilder::extract(const cv::Mat& gray, int num_features, RawFeatures& o
   extractor_.extract(gray, num_features, out.keys, out.descriptors);
 }
 
+void FrameBuilder::extract(const feature::PreparedImage& prepared, int num_features, RawFeatures& out) {
+  extractor_.extract(prepared, num_features, out.keys, out.descriptors);
+}
+
 std::shared_ptr<map::FrameFeatures> FrameBuilder::begin_features(RawFeatures&& raw) const {
   auto f = std::make_shared<map::FrameFeatures>();
   f->keys = std::move(raw.keys);

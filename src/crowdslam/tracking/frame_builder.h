@@ -40,6 +40,9 @@ class FrameBuilder {
                std::shared_ptr<const bow::Vocabulary> vocabulary = nullptr);
 
   void extract(const cv::Mat& gray, int num_features, RawFeatures& out);
+  // The same from what an extractor with these options prepared (feature::ORBExtractor::prepare).
+  void extract(const feature::PreparedImage& prepared, int num_features, RawFeatures& out);
+  [[nodiscard]] const feature::ORBExtractor::Options& orb_options() const { return extractor_.options(); }
   // depth_raw: CV_16UC1 raw depth (0 = none) of the same size as the image, or empty (monocular).
   [[nodiscard]] std::shared_ptr<map::FrameFeatures> assemble(RawFeatures&& raw, const cv::Mat& depth_raw) const;
 
