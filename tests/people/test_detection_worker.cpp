@@ -7,6 +7,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "crowdslam/people/detection_worker.h"
 
@@ -74,7 +75,8 @@ TEST(DetectionWorker, WaitAfterTheResultIsReadyDoesNotBlock) {
   worker.submit(0, image_with(1));
   while (fake->calls.load() == 0) std::this_thread::sleep_for(1ms);
   std::this_thread::sleep_for(20ms);
-  EXPECT_LT(worker.wait(0).waited_ms, 100.0);  // nothing to wait for (a loaded machine may deschedule us briefly)
+  EXPECT_LT(worker.wait(0).waited_ms,
+            100.0);  // nothing to wait for (a loaded machine may deschedule us briefly)
 }
 
 TEST(DetectionWorker, DetectorExceptionReachesWaitAndWorkerStaysUsable) {
@@ -168,6 +170,70 @@ TEST(DetectionWorkerLatest, DetectorExceptionReachesPoll) {
   }
   EXPECT_TRUE(thrown);
   EXPECT_TRUE(worker.offer(1, image_with(1)));  // usable again
+}
+
+}  // namespace
+}  // namespace crowdslam::people
+
+namespace crowdslam::people {
+namespace {
+
+// Ahead of tracking: a reader thread submits frames as they are decoded, tracking collects each in
+// its turn. Results are the frames' own, in order; frames never collected (a paced run's drops) are
+// discarded; an exception reaches the frame it belongs to.
+TEST(DetectionWorkerAhead, FramesSubmittedFromAnotherThreadComeBackInTheirTurn) {
+  auto detector = std::make_unique<FakeDetector>(2ms);
+  FakeDetector* fake = detector.get();
+  DetectionWorker worker(std::move(detector));
+  std::vector<std::size_t> tickets(30);
+  std::thread reader([&] {
+    for (std::size_t k = 0; k < tickets.size(); ++k)
+      tickets[k] = worker.submit_ahead(k, image_with(int(k) + 1));
+  });
+  reader.join();
+  for (std::size_t k = 0; k < tickets.size(); ++k) {
+    EXPECT_EQ(tickets[k], k + 1);
+    if (k % 3 == 2) continue;  // dropped: never collected
+    const WorkerResult r = worker.wait_ahead(tickets[k]);
+    EXPECT_EQ(r.frame_index, k);
+    ASSERT_EQ(r.detections.boxes.size(), 1u);
+    EXPECT_FLOAT_EQ(r.detections.boxes[0].box.x, static_cast<float>(k));
+    EXPECT_FLOAT_EQ(r.detections.boxes[0].box.width, static_cast<float>(k + 1));
+  }
+  // A dropped frame's ticket is gone once a later one was collected; so is a collected one.
+  EXPECT_THROW(worker.wait_ahead(tickets[2]), std::logic_error);
+  EXPECT_THROW(worker.wait_ahead(tickets[0]), std::logic_error);
+  EXPECT_THROW(worker.wait_ahead(tickets.size() + 5), std::logic_error);
+  EXPECT_LE(fake->calls.load(), 30);
+}
+
+TEST(DetectionWorkerAhead, WaitBlocksUntilTheFramesTurnAndAnExceptionReachesItsFrame) {
+  DetectionWorker worker(std::make_unique<FakeDetector>(150ms, 1));
+  const std::size_t first = worker.submit_ahead(0, image_with(1));
+  const std::size_t failing = worker.submit_ahead(1, image_with(1));
+  const std::size_t third = worker.submit_ahead(2, image_with(9));
+  const auto start = std::chrono::steady_clock::now();
+  const WorkerResult r = worker.wait_ahead(first);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 100ms);  // waited for its detection
+  EXPECT_GT(r.waited_ms, 100.0);
+  try {
+    worker.wait_ahead(failing);
+    FAIL() << "expected the detector's exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "fake failure on frame 1");
+  }
+  const WorkerResult after = worker.wait_ahead(third);  // the worker goes on after a failure
+  ASSERT_EQ(after.detections.boxes.size(), 1u);
+  EXPECT_FLOAT_EQ(after.detections.boxes[0].box.width, 9.0f);
+}
+
+TEST(DetectionWorkerAhead, ShutdownWithFramesQueuedAndNeverCollected) {
+  const auto start = std::chrono::steady_clock::now();
+  {
+    DetectionWorker worker(std::make_unique<FakeDetector>(50ms));
+    for (std::size_t k = 0; k < 10; ++k) worker.submit_ahead(k, image_with(1));
+  }  // the destructor drops the queue: at most the running detection is finished
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 300ms);
 }
 
 }  // namespace

@@ -63,6 +63,36 @@ WorkerResult DetectionWorker::take_result() {
   return out;
 }
 
+std::size_t DetectionWorker::submit_ahead(std::size_t frame_index, cv::Mat bgr) {
+  std::size_t ticket = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ticket = ++last_ticket_;
+    ahead_queue_.push_back(AheadJob{ticket, frame_index, std::move(bgr)});
+  }
+  wake_worker_.notify_one();
+  return ticket;
+}
+
+WorkerResult DetectionWorker::wait_ahead(std::size_t ticket) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (ticket == 0 || ticket > last_ticket_ || ticket <= collected_ticket_)
+    throw std::logic_error("DetectionWorker::wait_ahead(" + std::to_string(ticket) + "): no such ticket in flight");
+  result_ready_.wait(lock, [&] { return ahead_results_.count(ticket) > 0; });
+  AheadResult result = std::move(ahead_results_.at(ticket));
+  // This ticket and every earlier one are done with: their frames were collected or dropped.
+  ahead_results_.erase(ahead_results_.begin(), ahead_results_.upper_bound(ticket));
+  collected_ticket_ = ticket;
+  lock.unlock();
+  if (result.error) std::rethrow_exception(result.error);
+  WorkerResult out;
+  out.frame_index = result.frame_index;
+  out.detections = std::move(result.detections);
+  out.waited_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
 bool DetectionWorker::offer(std::size_t frame_index, const cv::Mat& bgr) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -90,8 +120,26 @@ std::optional<WorkerResult> DetectionWorker::poll() {
 void DetectionWorker::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
-    wake_worker_.wait(lock, [this] { return stop_ || state_ == State::kPending; });
+    wake_worker_.wait(lock, [this] { return stop_ || state_ == State::kPending || !ahead_queue_.empty(); });
     if (stop_) return;
+    if (state_ != State::kPending) {
+      AheadJob job = std::move(ahead_queue_.front());
+      ahead_queue_.pop_front();
+      if (job.ticket <= collected_ticket_) continue;  // its frame was dropped and a later one collected
+      lock.unlock();
+      AheadResult result;
+      result.frame_index = job.frame_index;
+      try {
+        result.detections = detector_->detect(job.image, job.frame_index);
+      } catch (...) {
+        result.error = std::current_exception();
+      }
+      job.image.release();
+      lock.lock();
+      if (job.ticket > collected_ticket_) ahead_results_.emplace(job.ticket, std::move(result));
+      result_ready_.notify_all();
+      continue;
+    }
     state_ = State::kRunning;
     const cv::Mat image = image_;
     const std::size_t frame_index = frame_index_;

@@ -19,11 +19,24 @@
 //
 // offer() returns false (and does nothing) while a frame is in flight or its result was not collected.
 //
+// Ahead of tracking (every_frame mode fed by the thread that reads the frames):
+//
+//   ticket = worker.submit_ahead(k, colour);   // reader thread, as soon as frame k is decoded
+//   ...
+//   WorkerResult r = worker.wait_ahead(ticket);  // tracking thread, in the frame's turn
+//
+// Frames submitted ahead are detected in submission order (after a submit()/offer() frame in flight),
+// each result kept until its ticket is collected; collecting a ticket discards the results of earlier
+// tickets never collected (frames a paced run dropped). submit_ahead() may be called from one other
+// thread than the rest.
+//
 // Thread safety: submit(), wait(), offer() and poll() are meant for one caller thread (tracking); all state shared with the
 // worker thread is guarded by one mutex.
 #include <condition_variable>
 #include <cstddef>
+#include <deque>
 #include <exception>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -54,11 +67,26 @@ class DetectionWorker {
   std::optional<WorkerResult> poll();
   // No frame in flight and no result waiting: offer() would start.
   [[nodiscard]] bool idle();
+  // Queues `bgr` (kept by reference, not copied) for detection; returns its ticket (1, 2, ...).
+  std::size_t submit_ahead(std::size_t frame_index, cv::Mat bgr);
+  // Blocks until the ticket's result is ready; rethrows the detector's exception for that frame; a
+  // ticket never issued, or already collected or discarded, is a std::logic_error.
+  WorkerResult wait_ahead(std::size_t ticket);
 
   [[nodiscard]] const PersonDetector& detector() const { return *detector_; }
 
  private:
   enum class State { kIdle, kPending, kRunning, kDone };
+  struct AheadJob {
+    std::size_t ticket = 0;
+    std::size_t frame_index = 0;
+    cv::Mat image;
+  };
+  struct AheadResult {
+    std::size_t frame_index = 0;
+    Detections detections;
+    std::exception_ptr error;
+  };
 
   void run();
   // The finished result (state kDone, mutex held); rethrows the detector's exception. Back to kIdle.
@@ -74,6 +102,10 @@ class DetectionWorker {
   cv::Mat image_;
   Detections result_;
   std::exception_ptr error_;
+  std::deque<AheadJob> ahead_queue_;
+  std::map<std::size_t, AheadResult> ahead_results_;
+  std::size_t last_ticket_ = 0;     // issued
+  std::size_t collected_ticket_ = 0;  // tickets up to this one are collected or discarded
   std::thread thread_;  // last: started after every other member is initialised
 };
 

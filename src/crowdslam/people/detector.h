@@ -72,6 +72,8 @@ class PersonDetector {
   // sequence (file-based detectors look boxes up by it; network detectors ignore it).
   virtual Detections detect(const cv::Mat& bgr, std::size_t frame_index) = 0;
   [[nodiscard]] virtual std::string name() const = 0;
+  // False when the boxes come from frame_index alone (a file), so the pixels are not looked at.
+  [[nodiscard]] virtual bool reads_pixels() const { return true; }
 };
 
 // Clips a box to [0, width) x [0, height). Returns an empty rect (width or height <= 0) when nothing is

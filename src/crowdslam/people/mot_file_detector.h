@@ -26,6 +26,7 @@ class MotFileDetector : public PersonDetector {
 
   Detections detect(const cv::Mat& bgr, std::size_t frame_index) override;
   [[nodiscard]] std::string name() const override { return "mot-file:" + path_; }
+  [[nodiscard]] bool reads_pixels() const override { return false; }
 
   [[nodiscard]] int last_frame() const;  // largest 1-based frame with a box, 0 if none
   [[nodiscard]] std::size_t box_count() const { return box_count_; }  // after the confidence threshold

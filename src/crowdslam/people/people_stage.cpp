@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 
 #include "crowdslam/people/box_depth.h"
 #include "crowdslam/people/detector_setup.h"
@@ -254,11 +255,26 @@ void PeopleStage::take_detection(WorkerResult result, const FlowImage& image) {
   }
 }
 
-void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv::Mat& gray) {
+bool PeopleStage::detects_ahead() const {
+  return mode_ == DetectorMode::kEveryFrame && worker_->detector().reads_pixels();
+}
+
+std::size_t PeopleStage::submit_ahead(std::size_t index, const cv::Mat& colour) {
+  if (!detects_ahead()) throw std::logic_error("PeopleStage::submit_ahead: not in every_frame mode with a network");
+  return worker_->submit_ahead(index, colour);
+}
+
+void PeopleStage::begin_frame(std::size_t index, const cv::Mat& colour, const cv::Mat& gray,
+                              std::optional<std::size_t> ahead_ticket) {
   fresh_ = false;
   detection_ms_ = 0;
+  ahead_ticket_.reset();
   if (mode_ == DetectorMode::kEveryFrame) {
-    worker_->submit(index, colour);
+    if (ahead_ticket) {
+      ahead_ticket_ = ahead_ticket;
+    } else {
+      worker_->submit(index, colour);
+    }
     if (tracker_) move_to(make_flow_image(gray, flow_options_));  // coasting tracks follow the image
     return;
   }
@@ -301,7 +317,8 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   PeopleFrame out;
   std::vector<PersonBox> boxes, area_boxes;
   if (mode_ == DetectorMode::kEveryFrame) {
-    WorkerResult result = worker_->wait(index);
+    WorkerResult result = ahead_ticket_ ? worker_->wait_ahead(*ahead_ticket_) : worker_->wait(index);
+    ahead_ticket_.reset();
     out.detector_wait_ms = result.waited_ms;
     if (tracker_) {
       take_detection(std::move(result), current_);

@@ -78,7 +78,14 @@ class PeopleStage {
   // Before ORB extraction of frame `index` (colour BGR or grey, `gray` its grey version): every_frame
   // submits the frame to the detector; latest moves the current boxes to this frame, takes a finished
   // detection if there is one and hands this frame to the detector when it is free.
-  void begin_frame(std::size_t index, const cv::Mat& colour, const cv::Mat& gray);
+  // `ahead_ticket`: the frame was given to the detector before its turn (submit_ahead), not again here.
+  void begin_frame(std::size_t index, const cv::Mat& colour, const cv::Mat& gray,
+                   std::optional<std::size_t> ahead_ticket = std::nullopt);
+  // every_frame mode with a network detector: the detector may start on a frame before begin_frame(),
+  // from the thread that reads the frames (System::prepare), so the frame does not wait for its boxes
+  // when its turn comes. Returns the ticket for begin_frame(). The boxes are the frame's own either way.
+  [[nodiscard]] bool detects_ahead() const;
+  std::size_t submit_ahead(std::size_t index, const cv::Mat& colour);
   // After extraction (and stereo matching): the frame's boxes (every_frame waits for them), the keypoints
   // on people removed from `raw`, and the next frame's feature budget.
   PeopleFrame filter(std::size_t index, const io::FrameImages& images, feature::RawFeatures& raw,
@@ -95,6 +102,7 @@ class PeopleStage {
  private:
   // A detection result in the current frame's coordinates: moved from its own frame's grey image.
   void take_detection(WorkerResult result, const FlowImage& image);
+  std::optional<std::size_t> ahead_ticket_;  // this frame's, from begin_frame()
   // Boxes the filter uses now, and the ones (NMS level) that say how much of the image people cover.
   void current_boxes(std::vector<PersonBox>& filter_boxes,
                      std::vector<PersonBox>& area_boxes) const;

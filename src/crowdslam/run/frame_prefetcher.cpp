@@ -66,7 +66,7 @@ void FramePrefetcher::run() {
       break;
     }
     if (!frame) break;
-    std::shared_ptr<const feature::PreparedImage> prepared;
+    std::shared_ptr<const system::PreparedFrame> prepared;
     if (prepare_) {
       try {
         prepared = prepare_(frame->images);

@@ -1,8 +1,10 @@
 #pragma once
 // Reads frames from a FrameSource on a background thread into a small bounded queue, so that image
-// decoding overlaps with tracking. With a `prepare` function the same thread also does the budget-
-// independent part of each frame's ORB extraction (System::prepare), off the tracking thread. End of stream and reader errors are delivered in order: next()
-// returns nullopt at the end, and rethrows the reader's exception at the point where it happened.
+// decoding overlaps with tracking. With a `prepare` function the same thread also starts each frame's
+// work that does not wait for its turn (System::prepare: the budget-independent part of its ORB
+// extraction here, its person detection on the detector's thread). End of stream and reader errors are
+// delivered in order: next() returns nullopt at the end, and rethrows the reader's exception at the point
+// where it happened.
 //
 // With `skip_bad_frames`, an InputError for one frame of a dataset on disk (which can go on to the next
 // frame) is counted and the frame skipped instead; videos and cameras still stop at an error.
@@ -16,8 +18,8 @@
 #include <string>
 #include <thread>
 
-#include "crowdslam/feature/orb_extractor.h"
 #include "crowdslam/io/dataset.h"
+#include "crowdslam/system/system.h"
 
 namespace crowdslam::run {
 
@@ -28,12 +30,12 @@ struct SkippedFrames {
 
 struct PrefetchedFrame {
   io::Frame frame;
-  std::shared_ptr<const feature::PreparedImage> prepared;  // null without a prepare function, or refused
+  std::shared_ptr<const system::PreparedFrame> prepared;  // null without a prepare function, or refused
 };
 
 class FramePrefetcher {
  public:
-  using Prepare = std::function<std::shared_ptr<const feature::PreparedImage>(const io::FrameImages&)>;
+  using Prepare = std::function<std::shared_ptr<const system::PreparedFrame>(const io::FrameImages&)>;
   // `source` (and what `prepare` uses) must outlive the prefetcher. max_frames 0 = all.
   FramePrefetcher(io::FrameSource& source, size_t capacity = 3, size_t max_frames = 0, bool skip_bad_frames = false,
                   Prepare prepare = {});

@@ -67,6 +67,7 @@ system::SystemOptions system_options(const RunOptions& options, io::SensorKind s
   s.vocabulary_path = options.vocabulary;
   s.loop_closing = options.loop_closing;
   s.background_nice = options.background_nice;
+  s.prepare_detection = !options.pace_sensor;  // a paced run drops frames: no detection before their turn
   s.replay_waits_for_mapping = !options.pace_sensor;  // a paced replay is a live camera: it does not wait
   return s;
 }
@@ -230,7 +231,7 @@ RunSummary run_sequence(const RunOptions& options) {
   std::exception_ptr error;
   const auto run_start = Clock::now();
   const size_t expected = p.source->summary().frames.value_or(0);
-  // The reader thread also does the budget-independent part of each frame's extraction (System::prepare).
+  // The reader thread also starts each frame's extraction and detection (System::prepare).
   FramePrefetcher prefetcher(*p.source, 3, options.max_frames, options.skip_bad_frames,
                              [&slam](const io::FrameImages& images) { return slam.prepare(images); });
   std::optional<SensorPacer> pacer;

@@ -51,7 +51,7 @@ struct RunOptions {
   size_t save_frames = 0;            // --save-frames N: every N-th frame drawn into OUT/frames/
   std::string vocabulary;            // --vocabulary FILE | none ("" = the default vocabulary)
   bool loop_closing = true;          // --no-loop-closing
-  int background_nice = 10;          // --background-nice: mapping and loop closing this much nicer (0-19)
+  int background_nice = 0;           // --background-nice: mapping and loop closing this much nicer (0-19)
   bool skip_bad_frames = false;      // --skip-bad-frames: an unreadable frame is counted and skipped
   bool allow_untracked = false;      // --allow-untracked: a run that tracks no frame is not an error
   size_t journal_flush_frames = 10;  // the trajectory journal is flushed every N tracked frames

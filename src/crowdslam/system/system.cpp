@@ -227,15 +227,19 @@ std::string EndState::to_string() const {
   return "failed: " + reason;
 }
 
-std::shared_ptr<const feature::PreparedImage> System::prepare(const io::FrameImages& images) {
+std::shared_ptr<const PreparedFrame> System::prepare(const io::FrameImages& images) {
   if (rectifier_ || images.colour.empty()) return nullptr;
   if (!preparer_) preparer_ = std::make_unique<feature::ORBExtractor>(frame_builder_->orb_options());
-  auto prepared = std::make_shared<feature::PreparedImage>();
+  auto prepared = std::make_shared<PreparedFrame>();
   try {
-    preparer_->prepare(feature::to_gray(images.colour), *prepared);
+    preparer_->prepare(feature::to_gray(images.colour), prepared->orb);
   } catch (const InputError&) {
     return nullptr;  // track() reports it, in the frame's turn
   }
+  if (options_.prepare_detection && people_ && people_->detects_ahead()) {
+    prepared->detection_ticket = people_->submit_ahead(prepared_frames_, images.colour);
+  }
+  ++prepared_frames_;
   return prepared;
 }
 
@@ -244,7 +248,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
 }
 
 FrameReport System::track(const io::FrameImages& images, double timestamp_s,
-                          const feature::PreparedImage* prepared) {
+                          const PreparedFrame* prepared) {
   FrameReport report;
   report.index = next_frame_id_;
   report.timestamp_s = timestamp_s;
@@ -284,11 +288,13 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s,
   }
   // The detector works on its own thread while ORB features are extracted here.
   if (rectifier_) prepared = nullptr;  // prepared from the unrectified image
-  const cv::Mat gray = prepared ? prepared->gray : feature::to_gray(left_colour);
-  if (people_) people_->begin_frame(frame_index, left_colour, gray);
+  const cv::Mat gray = prepared ? prepared->orb.gray : feature::to_gray(left_colour);
+  if (people_) {
+    people_->begin_frame(frame_index, left_colour, gray, prepared ? prepared->detection_ticket : std::nullopt);
+  }
   feature::RawFeatures raw;
   if (prepared) {
-    frame_builder_->extract(*prepared, report.feature_budget, raw);
+    frame_builder_->extract(prepared->orb, report.feature_budget, raw);
   } else {
     frame_builder_->extract(gray, report.feature_budget, raw);
   }

@@ -53,9 +53,19 @@ struct SystemOptions {
   bool replay_waits_for_mapping = true;
   // Experiments and tests only: local mapping sleeps this long per keyframe (a slow mapper on demand).
   double mapper_delay_ms = 0;
-  // Local mapping and loop closing run this much nicer than tracking (0-19; 0 = the same priority), so
-  // the frame's path gets the cores first when every thread is busy (util/thread_priority.h).
-  int background_nice = 10;
+  // Local mapping and loop closing run this much nicer than tracking (0-19; 0 = the same priority): when
+  // every thread is busy the frame's path gets the cores first, and the mapper, getting less, makes fewer
+  // keyframes (util/thread_priority.h, docs/PROFILE.md).
+  int background_nice = 0;
+  // prepare() also starts the person detector on the frame (every_frame mode with a network). Off for a
+  // paced run, whose dropped frames would cost a detection each.
+  bool prepare_detection = true;
+};
+
+// What System::prepare() did for one frame ahead of track().
+struct PreparedFrame {
+  feature::PreparedImage orb;                    // the left image's budget-independent extraction
+  std::optional<std::size_t> detection_ticket;  // the detector started on the frame (every_frame mode)
 };
 
 // The vocabulary a System loaded, for run.json.
@@ -130,13 +140,16 @@ class System {
   // Observers see the frame before track() returns.
   FrameReport track(const io::FrameImages& images, double timestamp_s);
   // The same, with the left image's budget-independent extraction done ahead by prepare() (null: here).
-  FrameReport track(const io::FrameImages& images, double timestamp_s, const feature::PreparedImage* prepared);
-  // The part of a frame's ORB extraction that does not depend on the feature budget (pyramid, FAST
-  // corners, blurred levels: feature/orb_extractor.h), for track() to finish. Meant for the thread that
-  // reads the frames, while track() works on an earlier one: one caller thread at a time. Null when the
-  // frame is not prepared ahead (stereo with rectification, whose left image changes in track(), or an
-  // image the extractor refuses: track() then reports the error).
-  [[nodiscard]] std::shared_ptr<const feature::PreparedImage> prepare(const io::FrameImages& images);
+  FrameReport track(const io::FrameImages& images, double timestamp_s, const PreparedFrame* prepared);
+  // A frame's work that can start before its turn: the part of its ORB extraction that does not depend
+  // on the feature budget (pyramid, FAST corners, blurred levels: feature/orb_extractor.h) and, with
+  // SystemOptions::prepare_detection in every_frame mode, its person detection (on the detector's
+  // thread). Meant for the thread that reads the frames, while track() works on an earlier one: one
+  // caller thread at a time, frames in the order track() will get them (a frame prepared and then not
+  // tracked, as a paced run drops, is allowed). Null when the frame is not prepared ahead (stereo with
+  // rectification, whose left image changes in track(), or an image the extractor refuses: track() then
+  // reports the error). track() gives the same result with or without it.
+  [[nodiscard]] std::shared_ptr<const PreparedFrame> prepare(const io::FrameImages& images);
   // Lets local mapping (and loop closing) finish their queues and stops their threads (idempotent; the
   // destructor calls it).
   void shutdown();
@@ -234,6 +247,7 @@ class System {
   std::unique_ptr<tracking::FrameBuilder> frame_builder_;
   std::unique_ptr<geometry::StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
   std::unique_ptr<feature::ORBExtractor> preparer_;        // prepare()'s, made at its first call
+  size_t prepared_frames_ = 0;                             // prepare()'s count (the detector's index)
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   bool box_keypoints_ =

@@ -3,9 +3,10 @@
 //
 // Tracking is the run's critical path: every frame waits for it, and for the reader and the person
 // detector that feed it. Local mapping, loop closing and the global bundle adjustment take what CPU
-// they are given, and a busy mapper only makes keyframes less often. They therefore run with a lower
-// priority (a higher nice value), so on a machine with fewer cores than busy threads the kernel gives
-// the frame's path the core first (docs/PROFILE.md, "Thread priorities").
+// they are given, and a busy mapper only makes keyframes less often. SystemOptions::background_nice
+// (`crowdslam run --background-nice`) can therefore run them with a lower priority (a higher nice
+// value), so on a machine with fewer cores than busy threads the kernel gives the frame's path the core
+// first (docs/PROFILE.md, "Thread priorities").
 
 namespace crowdslam::util {
 
