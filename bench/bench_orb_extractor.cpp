@@ -1,5 +1,5 @@
 // Speed of the ORB extractor (target: median <= 10 ms for 1000 features on a 640x480 Bonn frame, one
-// thread) and of the Hamming distance.
+// thread), of its two steps apart (prepare, extract from the prepared image), and of the Hamming distance.
 //
 //   build-*/bench/bench_orb_extractor --benchmark_repetitions=5
 //
@@ -104,6 +104,46 @@ void BM_OrbExtractSequence(benchmark::State& state) {
   state.counters["frame_p95_ms"] = percentile(times_ms, 0.95);
 }
 BENCHMARK(BM_OrbExtractSequence)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(500);
+
+// The two steps apart: prepare() (pyramid, FAST, blur: the reader thread's share in `crowdslam run`) and
+// extract() from the prepared image (distribution, orientation, BRIEF: what is left on the tracking
+// thread), at the budgets of Bonn.yaml (1000) and of FNU's largest factor (2200).
+void BM_OrbPrepare(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat& gray = bonn_frame_gray();
+  if (gray.empty()) {
+    state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
+    return;
+  }
+  ORBExtractor extractor;
+  crowdslam::feature::PreparedImage prepared;
+  for (auto _ : state) {
+    extractor.prepare(gray, prepared);
+    benchmark::DoNotOptimize(prepared.blurred.back().data);
+  }
+}
+BENCHMARK(BM_OrbPrepare)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_OrbExtractPrepared(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat& gray = bonn_frame_gray();
+  if (gray.empty()) {
+    state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
+    return;
+  }
+  ORBExtractor extractor;
+  crowdslam::feature::PreparedImage prepared;
+  extractor.prepare(gray, prepared);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  const int budget = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    extractor.extract(prepared, budget, keypoints, descriptors);
+    benchmark::DoNotOptimize(descriptors.data);
+  }
+  state.counters["keypoints"] = static_cast<double>(keypoints.size());
+}
+BENCHMARK(BM_OrbExtractPrepared)->Arg(1000)->Arg(2200)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // For comparison: OpenCV's ORB on the same frame and budget (no grid, no quadtree).
 void BM_CvOrbDetectAndCompute(benchmark::State& state) {

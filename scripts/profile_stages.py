@@ -31,7 +31,11 @@ STAGES = [
     ("decode", "decoding (colour JPEG, depth PNG)", None,
      [r"crowdslam::io::decode_jpeg$", r"crowdslam::io::decode_png$"]),
     ("gray", "colour to gray", None, [r"crowdslam::feature::to_gray$"]),
-    ("extract", "ORB extraction", None, [r"crowdslam::feature::ORBExtractor::extract$"]),
+    # prepare() is the reader thread's part of a frame's extraction (System::prepare); extract() finishes it
+    # on the tracking thread. A frame that was not prepared (stereo with rectification) runs prepare()
+    # inside extract(), and is then counted twice: profile RGB-D or monocular runs.
+    ("extract", "ORB extraction", None,
+     [r"crowdslam::feature::ORBExtractor::extract$", r"crowdslam::feature::ORBExtractor::prepare$"]),
     ("pyramid", "pyramid", "extract", [r"crowdslam::feature::ORBExtractor::build_pyramid$"]),
     ("fast", "FAST (grid, fallback threshold)", "extract", [r"crowdslam::feature::ORBExtractor::detect_fast_grid$"]),
     ("distribute", "quadtree distribution", "extract", [r"crowdslam::feature::QuadtreeDistributor::distribute$"]),
