@@ -93,10 +93,11 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
                   "left images only)");
   cmd->add_flag("--sequential", args->options.sequential,
                 "Local mapping inline after each frame (reproducible); default: threaded");
-  cmd->add_option("--background-nice", args->options.background_nice,
-                  "Local mapping and loop closing run this much nicer than tracking (0-19, default 0: the same "
-                  "priority). On a machine the run saturates, the frame's path then gets the cores first and "
-                  "the mapper makes fewer keyframes (docs/PROFILE.md)")
+  cmd->add_option(
+         "--background-nice", args->options.background_nice,
+         "Local mapping and loop closing run this much nicer than tracking (0-19, default 0: the same "
+         "priority). On a machine the run saturates, the frame's path then gets the cores first and "
+         "the mapper makes fewer keyframes (docs/PROFILE.md)")
       ->check(CLI::Range(0, 19));
   cmd->add_option("--frames", args->frames, "Process only the first N frames (0 = all)")
       ->check(count());

@@ -212,11 +212,12 @@ void ORBExtractor::extract(const cv::Mat& gray, int num_features, std::vector<cv
   extract(prepared_, num_features, keypoints, descriptors);
 }
 
-void ORBExtractor::extract(const PreparedImage& prepared, int num_features, std::vector<cv::KeyPoint>& keypoints,
-                           cv::Mat& descriptors) {
+void ORBExtractor::extract(const PreparedImage& prepared, int num_features,
+                           std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) {
   check_gray(prepared.gray);
   if (prepared.pyramid.size() != static_cast<std::size_t>(options_.num_levels) ||
-      prepared.blurred.size() != prepared.pyramid.size() || prepared.corners.size() != prepared.pyramid.size()) {
+      prepared.blurred.size() != prepared.pyramid.size() ||
+      prepared.corners.size() != prepared.pyramid.size()) {
     throw InputError("ORB extractor: the prepared image has " + std::to_string(prepared.pyramid.size()) +
                      " levels, the extractor " + std::to_string(options_.num_levels));
   }

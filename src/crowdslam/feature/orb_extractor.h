@@ -35,9 +35,9 @@ namespace crowdslam::feature {
 
 // What ORBExtractor::prepare() computed for one image (valid with an extractor of the same options).
 struct PreparedImage {
-  cv::Mat gray;                                  // the image (level 0 shares its data)
-  std::vector<cv::Mat> pyramid;                  // per level; levels too small to exist are empty
-  std::vector<cv::Mat> blurred;                  // per level, GaussianBlur 7x7, sigma 2 (for BRIEF)
+  cv::Mat gray;                                    // the image (level 0 shares its data)
+  std::vector<cv::Mat> pyramid;                    // per level; levels too small to exist are empty
+  std::vector<cv::Mat> blurred;                    // per level, GaussianBlur 7x7, sigma 2 (for BRIEF)
   std::vector<std::vector<cv::KeyPoint>> corners;  // per level, FAST corners in level coordinates
 };
 

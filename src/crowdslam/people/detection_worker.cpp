@@ -78,7 +78,8 @@ WorkerResult DetectionWorker::wait_ahead(std::size_t ticket) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_lock<std::mutex> lock(mutex_);
   if (ticket == 0 || ticket > last_ticket_ || ticket <= collected_ticket_)
-    throw std::logic_error("DetectionWorker::wait_ahead(" + std::to_string(ticket) + "): no such ticket in flight");
+    throw std::logic_error("DetectionWorker::wait_ahead(" + std::to_string(ticket) +
+                           "): no such ticket in flight");
   result_ready_.wait(lock, [&] { return ahead_results_.count(ticket) > 0; });
   AheadResult result = std::move(ahead_results_.at(ticket));
   // This ticket and every earlier one are done with: their frames were collected or dropped.

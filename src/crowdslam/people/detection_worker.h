@@ -30,8 +30,8 @@
 // tickets never collected (frames a paced run dropped). submit_ahead() may be called from one other
 // thread than the rest.
 //
-// Thread safety: submit(), wait(), offer() and poll() are meant for one caller thread (tracking); all state shared with the
-// worker thread is guarded by one mutex.
+// Thread safety: submit(), wait(), offer() and poll() are meant for one caller thread (tracking); all state
+// shared with the worker thread is guarded by one mutex.
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -104,7 +104,7 @@ class DetectionWorker {
   std::exception_ptr error_;
   std::deque<AheadJob> ahead_queue_;
   std::map<std::size_t, AheadResult> ahead_results_;
-  std::size_t last_ticket_ = 0;     // issued
+  std::size_t last_ticket_ = 0;       // issued
   std::size_t collected_ticket_ = 0;  // tickets up to this one are collected or discarded
   std::thread thread_;  // last: started after every other member is initialised
 };

@@ -260,7 +260,8 @@ bool PeopleStage::detects_ahead() const {
 }
 
 std::size_t PeopleStage::submit_ahead(std::size_t index, const cv::Mat& colour) {
-  if (!detects_ahead()) throw std::logic_error("PeopleStage::submit_ahead: not in every_frame mode with a network");
+  if (!detects_ahead())
+    throw std::logic_error("PeopleStage::submit_ahead: not in every_frame mode with a network");
   return worker_->submit_ahead(index, colour);
 }
 

@@ -7,8 +7,8 @@
 
 namespace crowdslam::run {
 
-FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames, bool skip_bad_frames,
-                                 Prepare prepare)
+FramePrefetcher::FramePrefetcher(io::FrameSource& source, size_t capacity, size_t max_frames,
+                                 bool skip_bad_frames, Prepare prepare)
     : source_(source),
       capacity_(std::max<size_t>(1, capacity)),
       max_frames_(max_frames),

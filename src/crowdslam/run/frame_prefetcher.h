@@ -37,8 +37,8 @@ class FramePrefetcher {
  public:
   using Prepare = std::function<std::shared_ptr<const system::PreparedFrame>(const io::FrameImages&)>;
   // `source` (and what `prepare` uses) must outlive the prefetcher. max_frames 0 = all.
-  FramePrefetcher(io::FrameSource& source, size_t capacity = 3, size_t max_frames = 0, bool skip_bad_frames = false,
-                  Prepare prepare = {});
+  FramePrefetcher(io::FrameSource& source, size_t capacity = 3, size_t max_frames = 0,
+                  bool skip_bad_frames = false, Prepare prepare = {});
   ~FramePrefetcher();
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;

@@ -247,8 +247,7 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s) {
   return track(images, timestamp_s, nullptr);
 }
 
-FrameReport System::track(const io::FrameImages& images, double timestamp_s,
-                          const PreparedFrame* prepared) {
+FrameReport System::track(const io::FrameImages& images, double timestamp_s, const PreparedFrame* prepared) {
   FrameReport report;
   report.index = next_frame_id_;
   report.timestamp_s = timestamp_s;
@@ -290,7 +289,8 @@ FrameReport System::track(const io::FrameImages& images, double timestamp_s,
   if (rectifier_) prepared = nullptr;  // prepared from the unrectified image
   const cv::Mat gray = prepared ? prepared->orb.gray : feature::to_gray(left_colour);
   if (people_) {
-    people_->begin_frame(frame_index, left_colour, gray, prepared ? prepared->detection_ticket : std::nullopt);
+    people_->begin_frame(frame_index, left_colour, gray,
+                         prepared ? prepared->detection_ticket : std::nullopt);
   }
   feature::RawFeatures raw;
   if (prepared) {

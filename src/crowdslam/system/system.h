@@ -64,7 +64,7 @@ struct SystemOptions {
 
 // What System::prepare() did for one frame ahead of track().
 struct PreparedFrame {
-  feature::PreparedImage orb;                    // the left image's budget-independent extraction
+  feature::PreparedImage orb;                   // the left image's budget-independent extraction
   std::optional<std::size_t> detection_ticket;  // the detector started on the frame (every_frame mode)
 };
 
@@ -246,8 +246,8 @@ class System {
   std::unique_ptr<loop::LoopCloser> loop_closer_;              // with a vocabulary and loop closing on
   std::unique_ptr<tracking::FrameBuilder> frame_builder_;
   std::unique_ptr<geometry::StereoRectifier> rectifier_;  // stereo with LEFT/RIGHT blocks only
-  std::unique_ptr<feature::ORBExtractor> preparer_;        // prepare()'s, made at its first call
-  size_t prepared_frames_ = 0;                             // prepare()'s count (the detector's index)
+  std::unique_ptr<feature::ORBExtractor> preparer_;       // prepare()'s, made at its first call
+  size_t prepared_frames_ = 0;                            // prepare()'s count (the detector's index)
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   bool box_keypoints_ =

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+
 #include "crowdslam/util/thread_priority.h"
 
 namespace crowdslam::viewer {
