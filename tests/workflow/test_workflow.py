@@ -256,3 +256,33 @@ if [[ -n "${{HANG_AT:-}}" && "$*" == *"$HANG_AT"* ]]; then touch "{flag}"; exec 
     table = json.load(open(smoke / "table.json"))
     assert all(c["complete"] == 2 for c in table["cases"].values())
     assert aggregate.run_figures(str(case / "2")) is not None
+
+
+def test_stale_staging_directories_of_dead_and_zombie_jobs_are_removed(tmp_path):
+    """run_job.remove_stale keeps the staging directory of a job that runs, and removes those of jobs
+    that are gone or are zombies (killed, not yet reaped: a killed snakemake's orphaned job waits for
+    init to reap it, which made the rerun of test_interrupted_job_leaves_no_result keep it)."""
+    import run_job  # noqa: E402 (workflows/scripts is on sys.path)
+    final = tmp_path / "case" / "2"
+    final.parent.mkdir()
+    live = subprocess.Popen(["sleep", "30"])
+    zombie = subprocess.Popen(["true"])
+    try:
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:  # `true` has exited, and nobody has reaped it
+            with open(f"/proc/{zombie.pid}/stat") as f:
+                if f.read().rsplit(")", 1)[1].split()[0] == "Z":
+                    break
+            time.sleep(0.01)
+        gone = subprocess.Popen(["true"])
+        gone.wait()  # exited and reaped: its pid runs nothing (unless reused at once)
+        for pid in (live.pid, zombie.pid, gone.pid):
+            (tmp_path / "case" / f"2.tmp-{pid}").mkdir()
+        (tmp_path / "case" / "2.tmp-notapid").mkdir()
+        run_job.remove_stale(str(final))
+        left = sorted(p.name for p in (tmp_path / "case").iterdir())
+        assert left == [f"2.tmp-{live.pid}"]
+    finally:
+        live.kill()
+        live.wait()
+        zombie.wait()

@@ -60,6 +60,22 @@ def loadavg():
         return None
 
 
+def running(pid):
+    """True while process `pid` runs. A zombie (killed, not yet reaped: a killed job's orphan waits for
+    an init that may be slow to reap it) does not run."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return True  # no /proc: trust kill()
+
+
 def remove_stale(final):
     parent, base = os.path.split(os.path.abspath(final))
     if not os.path.isdir(parent):
@@ -69,11 +85,9 @@ def remove_stale(final):
             continue
         try:
             pid = int(name.rsplit("-", 1)[1])
-            os.kill(pid, 0)
-            continue  # still running
-        except (ValueError, ProcessLookupError):
-            pass
-        except PermissionError:
+        except ValueError:
+            pid = None
+        if pid is not None and running(pid):
             continue
         shutil.rmtree(os.path.join(parent, name), ignore_errors=True)
 

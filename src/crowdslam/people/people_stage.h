@@ -4,7 +4,9 @@
 //
 // Two detector modes (Detector.mode):
 //  - every_frame: the detector runs on every frame, beside ORB extraction, and the frame waits for its
-//    boxes (the paper's design: a slow detector slows SLAM down to its own rate);
+//    boxes (the paper's design: a slow detector slows SLAM down to its own rate). A run's reader thread
+//    may start a frame's detection as soon as the frame is read (submit_ahead, System::prepare), so the
+//    boxes are usually ready in the frame's turn;
 //  - latest: the detector takes the newest frame whenever it is free and tracking never waits; each frame
 //    uses the newest finished detection moved to it with the image motion (box_flow.h), marked as
 //    propagated when the detection was made on an earlier frame.
