@@ -7,11 +7,13 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "crowdslam/io/dataset.h"
 #include "crowdslam/io/settings.h"
@@ -124,7 +126,12 @@ int mapper_nice(const std::filesystem::path& seq, int background_nice) {
     auto frame = dataset->next();
     slam.track(frame->images, frame->info.timestamp_s);
   }
-  const int nice = nice_of_thread("cs-mapper");
+  // The mapper thread names itself when it starts: wait for it (a loaded machine may start it late).
+  int nice = nice_of_thread("cs-mapper");
+  for (int i = 0; i < 500 && nice == -100; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    nice = nice_of_thread("cs-mapper");
+  }
   slam.shutdown();
   return nice;
 }

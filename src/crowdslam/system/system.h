@@ -146,9 +146,9 @@ class System {
   // SystemOptions::prepare_detection in every_frame mode, its person detection (on the detector's
   // thread). Meant for the thread that reads the frames, while track() works on an earlier one: one
   // caller thread at a time, frames in the order track() will get them (a frame prepared and then not
-  // tracked, as a paced run drops, is allowed). Null when the frame is not prepared ahead (stereo with
-  // rectification, whose left image changes in track(), or an image the extractor refuses: track() then
-  // reports the error). track() gives the same result with or without it.
+  // tracked, as a paced run drops, is allowed). Null when the frame is not prepared ahead (monocular;
+  // stereo with rectification, whose left image changes in track(); or an image the extractor refuses:
+  // track() then reports the error). track() gives the same result with or without it.
   [[nodiscard]] std::shared_ptr<const PreparedFrame> prepare(const io::FrameImages& images);
   // Lets local mapping (and loop closing) finish their queues and stops their threads (idempotent; the
   // destructor calls it).
