@@ -40,13 +40,17 @@ const cv::Mat& bonn_frame_gray() {
   return gray;
 }
 
-void BM_OrbExtract(benchmark::State& state) {
+// The Bonn frame with OpenCV's pool off; empty, and the benchmark marked skipped, without ../shared.
+const cv::Mat& single_thread_bonn_frame(benchmark::State& state) {
   cv::setNumThreads(1);
   const cv::Mat& gray = bonn_frame_gray();
-  if (gray.empty()) {
-    state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
-    return;
-  }
+  if (gray.empty()) state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
+  return gray;
+}
+
+void BM_OrbExtract(benchmark::State& state) {
+  const cv::Mat& gray = single_thread_bonn_frame(state);
+  if (gray.empty()) return;
   ORBExtractor extractor;
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
@@ -109,12 +113,8 @@ BENCHMARK(BM_OrbExtractSequence)->Unit(benchmark::kMillisecond)->UseRealTime()->
 // extract() from the prepared image (distribution, orientation, BRIEF: what is left on the tracking
 // thread), at the budgets of Bonn.yaml (1000) and of FNU's largest factor (2200).
 void BM_OrbPrepare(benchmark::State& state) {
-  cv::setNumThreads(1);
-  const cv::Mat& gray = bonn_frame_gray();
-  if (gray.empty()) {
-    state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
-    return;
-  }
+  const cv::Mat& gray = single_thread_bonn_frame(state);
+  if (gray.empty()) return;
   ORBExtractor extractor;
   crowdslam::feature::PreparedImage prepared;
   for (auto _ : state) {
@@ -125,12 +125,8 @@ void BM_OrbPrepare(benchmark::State& state) {
 BENCHMARK(BM_OrbPrepare)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_OrbExtractPrepared(benchmark::State& state) {
-  cv::setNumThreads(1);
-  const cv::Mat& gray = bonn_frame_gray();
-  if (gray.empty()) {
-    state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
-    return;
-  }
+  const cv::Mat& gray = single_thread_bonn_frame(state);
+  if (gray.empty()) return;
   ORBExtractor extractor;
   crowdslam::feature::PreparedImage prepared;
   extractor.prepare(gray, prepared);
@@ -147,12 +143,8 @@ BENCHMARK(BM_OrbExtractPrepared)->Arg(1000)->Arg(2200)->Unit(benchmark::kMillise
 
 // For comparison: OpenCV's ORB on the same frame and budget (no grid, no quadtree).
 void BM_CvOrbDetectAndCompute(benchmark::State& state) {
-  cv::setNumThreads(1);
-  const cv::Mat& gray = bonn_frame_gray();
-  if (gray.empty()) {
-    state.SkipWithError("Bonn frame not found (set CROWDSLAM_SHARED)");
-    return;
-  }
+  const cv::Mat& gray = single_thread_bonn_frame(state);
+  if (gray.empty()) return;
   const auto orb = cv::ORB::create(static_cast<int>(state.range(0)), 1.2f, 8, 19, 0, 2, cv::ORB::FAST_SCORE);
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
