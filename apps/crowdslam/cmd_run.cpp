@@ -132,6 +132,10 @@ void add_run_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("--save-frames", args->options.save_frames,
                   "Write every N-th frame with boxes and kept/removed keypoints to OUT/frames/")
       ->check(count());
+  cmd->add_flag(
+      "--score-filter", args->options.score_filter,
+      "Count the people filter's kept and removed keypoints on the person masks of DATASET/people_mask "
+      "(written by crowdslam synth) into run.json people_masks");
   cmd->add_option(
       "--vocabulary", args->options.vocabulary,
       "ORB vocabulary for relocalisation (default: $CROWDSLAM_VOCABULARY or vocabulary/crowdslam_orb.voc); "

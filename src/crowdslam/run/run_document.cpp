@@ -316,6 +316,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                          {"detector_wait_ms_median", percentile(detector_wait_ms, 0.5)},
                                          {"detector_wait_ms_p95", percentile(detector_wait_ms, 0.95)}}
                         : nlohmann::json(nullptr);
+  if (!c.filter_score.is_null()) doc["people_masks"] = c.filter_score;  // also without the filter
   doc["ground"] = ground_json(slam);
   const auto& g = s.geometry;
   doc["geometry"] = {{"dynamic_check", g.dynamic_check},

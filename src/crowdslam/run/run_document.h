@@ -51,6 +51,7 @@ struct RunContext {
   const std::vector<double>& load_ms;
   nlohmann::json input;  // input warnings and skipped frames
   nlohmann::json map;    // loaded / saved map (run/map_files.h), null without either
+  nlohmann::json filter_score = nullptr;  // --score-filter (filter_mask_score.h): run.json people_masks
 };
 nlohmann::json final_document(const RunContext& context, const std::vector<system::FrameReport>& reports,
                               const RunSummary& summary, const nlohmann::json& accuracy);

@@ -14,6 +14,7 @@
 #include "crowdslam/journal/output_dir.h"
 #include "crowdslam/journal/run_journal.h"
 #include "crowdslam/report/run_report.h"
+#include "crowdslam/run/filter_mask_score.h"
 #include "crowdslam/run/frame_prefetcher.h"
 #include "crowdslam/run/input_checks.h"
 #include "crowdslam/run/map_files.h"
@@ -63,7 +64,8 @@ system::SystemOptions system_options(const RunOptions& options, io::SensorKind s
   s.people_filter = options.people_filter;
   s.detections_file = options.detections_file;
   s.detector_model = options.detector_model;
-  s.record_keypoints = options.save_frames > 0 || options.viewer;  // drawn by the journal / the viewer
+  // Drawn by the journal / the viewer; scored against the person masks.
+  s.record_keypoints = options.save_frames > 0 || options.viewer || options.score_filter;
   s.vocabulary_path = options.vocabulary;
   s.loop_closing = options.loop_closing;
   s.background_nice = options.background_nice;
@@ -179,6 +181,9 @@ RunSummary run_sequence(const RunOptions& options) {
   journal::check_output_dir(options.out_dir, options.overwrite);  // before anything is read
   check_map_options(options);
   Prepared p = prepare(options);
+  // A dataset without person masks fails before any output (and before the system starts its threads).
+  std::optional<FilterMaskScore> filter_score;
+  if (options.score_filter) filter_score.emplace(std::filesystem::path(options.dataset) / "people_mask");
   system::System slam(p.run_settings, system_options(options, p.sensor));
   nlohmann::json map_json = load_map_if_requested(options, slam);  // a bad map fails before any output
   std::unique_ptr<ViewerSession> viewer;  // a port in use fails before any output too
@@ -223,6 +228,7 @@ RunSummary run_sequence(const RunOptions& options) {
   slam.add_observer(&journal);
   if (viewer) slam.add_observer(&viewer->observer());
   for (auto* observer : options.observers) slam.add_observer(observer);
+  if (filter_score) slam.add_observer(&*filter_score);
 
   InputMonitor monitor(p.run_settings, p.sensor);
   std::vector<system::FrameReport> reports;
@@ -366,8 +372,11 @@ RunSummary run_sequence(const RunOptions& options) {
       skipped.first_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(skipped.first_error);
   if (skipped.count > 1)
     spdlog::warn("{} unreadable frames skipped (first: {})", skipped.count, skipped.first_error);
-  const RunContext context{options, p.settings_path, p.sensor, p.run_settings, slam,
-                           wall_s,  load_ms,         input,    map_json};
+  const RunContext context{options,  p.settings_path,
+                           p.sensor, p.run_settings,
+                           slam,     wall_s,
+                           load_ms,  input,
+                           map_json, filter_score ? filter_score->to_json() : nlohmann::json(nullptr)};
   summary.json = final_document(context, reports, summary, accuracy);
   write_final_outputs(out, slam, format, summary.json);
   report::write_run_report(out, summary.json);  // never fails the run: logged, recorded in run.json

@@ -49,6 +49,7 @@ struct RunOptions {
   std::string geometry;              // --geometry: overrides Geometry.dynamic_check (on | off)
   std::string ground;                // --ground: overrides Ground.enabled (on | off)
   size_t save_frames = 0;            // --save-frames N: every N-th frame drawn into OUT/frames/
+  bool score_filter = false;  // --score-filter: the filter against DATASET/people_mask (filter_mask_score.h)
   std::string vocabulary;            // --vocabulary FILE | none ("" = the default vocabulary)
   bool loop_closing = true;          // --no-loop-closing
   int background_nice = 0;           // --background-nice: mapping and loop closing this much nicer (0-19)
