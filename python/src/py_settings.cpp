@@ -53,6 +53,7 @@ void bind_settings(py::module_& m) {
       .def_readwrite("mode", &io::PeopleFilterSettings::mode)
       .def_readwrite("margin_px", &io::PeopleFilterSettings::margin_px)
       .def_readwrite("depth_margin_m", &io::PeopleFilterSettings::depth_margin_m)
+      .def_readwrite("segment_from_m", &io::PeopleFilterSettings::segment_from_m)
       .def_readwrite("right_image", &io::PeopleFilterSettings::right_image);
   py::class_<io::FeatureBudgetSettings>(m, "FeatureBudgetSettings", "FeatureBudget.* keys.")
       .def_readwrite("enabled", &io::FeatureBudgetSettings::enabled)

@@ -138,6 +138,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   s.detector.preprocess = "bytetrack";
   s.detector.resize = "letterbox";
   s.people_filter.mode = "paper";
+  s.people_filter.segment_from_m = 0.25;
   s.feature_budget.thresholds = {0.0, 0.5};
   s.feature_budget.factors = {1.0, 1.25, 3.0};
   s.output.trajectory_format = "kitti";
@@ -160,6 +161,7 @@ TEST(Settings, RoundTripThroughWriteSettings) {
   EXPECT_EQ(back.tracking.reanchor_max_s, 1.5);
   EXPECT_EQ(back.tracking.odometry_sigma_deg, 0.1 + 0.2);
   EXPECT_EQ(back.tracking.keyframe_reference_ratio, 0.75);
+  EXPECT_EQ(back.people_filter.segment_from_m, 0.25);
   EXPECT_TRUE(back.ground.enabled);
   EXPECT_EQ(back.ground.keyframe_sigma, 0.1 + 0.2);
   // A monocular settings object without rectification also survives.
@@ -302,6 +304,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "PeopleFilter.right_image: must be \"matched\" or \"boxes\""},
         BadValue{"PeopleFilter.margin_px", "PeopleFilter.margin_px: -2",
                  "PeopleFilter.margin_px: must be >= 0"},
+        BadValue{"PeopleFilter.segment_from_m", "PeopleFilter.segment_from_m: -0.1",
+                 "PeopleFilter.segment_from_m: must be >= 0"},
         BadValue{"PeopleFilter.static_check_below", "PeopleFilter.static_check_below: -1",
                  "PeopleFilter.static_check_below: must be >= 0"},
         BadValue{"PeopleFilter.static_in_boxes", "PeopleFilter.static_in_boxes: \"sometimes\"",

@@ -90,6 +90,7 @@ void read_own_sections(const SettingsReader& r, Settings& s) {
   set_if(r.real("PeopleFilter.margin_px"), s.people_filter.margin_px);
   set_if(r.real("PeopleFilter.depth_margin_m"), s.people_filter.depth_margin_m);
   set_if(r.flag("PeopleFilter.silhouettes"), s.people_filter.silhouettes);
+  set_if(r.real("PeopleFilter.segment_from_m"), s.people_filter.segment_from_m);
   set_if(r.text("PeopleFilter.right_image"), s.people_filter.right_image);
   set_if(r.text("PeopleFilter.static_in_boxes"), s.people_filter.static_in_boxes);
   set_if(r.integer("PeopleFilter.static_check_below"), s.people_filter.static_check_below);
@@ -195,6 +196,7 @@ bool operator==(const Settings& a, const Settings& b) {
                       a.people_filter.margin_px == b.people_filter.margin_px &&
                       a.people_filter.depth_margin_m == b.people_filter.depth_margin_m &&
                       a.people_filter.silhouettes == b.people_filter.silhouettes &&
+                      a.people_filter.segment_from_m == b.people_filter.segment_from_m &&
                       a.people_filter.right_image == b.people_filter.right_image &&
                       a.people_filter.flat_box_margin_m == b.people_filter.flat_box_margin_m;
   const auto& ga = a.geometry;

@@ -87,6 +87,11 @@ struct PeopleFilterSettings {
   double depth_margin_m = 0.5;
   // "depth" mode: a kept keypoint whose 5 x 5 neighbourhood shows the person (their outline) is dropped too.
   bool silhouettes = true;
+  // "depth" mode, RGB-D: a keypoint in a box more than this behind the person (and within the depth
+  // margin) is kept when it is off the person's surface grown from the box over the depth image
+  // (people/person_segment.h): a wall or plant close behind them, taken in by a loose box. 0 = off (the
+  // default): 0.15 kept more background in the crowds but made the ATE of some worse (docs/CROWDS.md).
+  double segment_from_m = 0;
   // Stereo: "matched" (default) drops a right keypoint only with its left match; "boxes" also drops the
   // stereo match of a kept left keypoint whose right coordinate falls in a (left-image) person box.
   std::string right_image = "matched";

@@ -196,6 +196,8 @@ void check_own_sections(const Checker& c, const Settings& s) {
             "\"matched\" or \"boxes\"", "\"" + p.right_image + "\"");
   c.require(std::isfinite(p.depth_margin_m) && p.depth_margin_m >= 0, "PeopleFilter.depth_margin_m", ">= 0",
             p.depth_margin_m);
+  c.require(std::isfinite(p.segment_from_m) && p.segment_from_m >= 0, "PeopleFilter.segment_from_m", ">= 0",
+            p.segment_from_m);
   c.require(p.static_check_below >= 0, "PeopleFilter.static_check_below", ">= 0", p.static_check_below);
   c.require(std::isfinite(p.flat_box_margin_m) && p.flat_box_margin_m >= 0, "PeopleFilter.flat_box_margin_m",
             ">= 0", p.flat_box_margin_m);

@@ -63,6 +63,7 @@ const std::vector<std::string>& known_settings_keys() {
                                   "PeopleFilter.margin_px",
                                   "PeopleFilter.depth_margin_m",
                                   "PeopleFilter.silhouettes",
+                                  "PeopleFilter.segment_from_m",
                                   "PeopleFilter.right_image",
                                   "PeopleFilter.static_in_boxes",
                                   "PeopleFilter.static_check_below",

@@ -107,6 +107,7 @@ void write_own_sections(std::ostream& out, const Settings& s) {
       << "\nPeopleFilter.mode: " << quoted(p.mode) << "\nPeopleFilter.margin_px: " << real_text(p.margin_px)
       << "\nPeopleFilter.depth_margin_m: " << real_text(p.depth_margin_m)
       << "\nPeopleFilter.silhouettes: " << (p.silhouettes ? 1 : 0)
+      << "\nPeopleFilter.segment_from_m: " << real_text(p.segment_from_m)
       << "\nPeopleFilter.right_image: " << quoted(p.right_image)
       << "\nPeopleFilter.static_in_boxes: " << quoted(p.static_in_boxes)
       << "\nPeopleFilter.static_check_below: " << p.static_check_below

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "crowdslam/people/box_depth.h"
+#include "crowdslam/people/person_segment.h"
 #include "crowdslam/util/error.h"
 
 namespace crowdslam::people {
@@ -25,6 +27,9 @@ void KeypointFilterOptions::check() const {
 }
 
 namespace {
+
+// A keypoint this close to the person's surface is on their outline (the middle of the ORB patch).
+constexpr int kSegmentRadiusPx = 8;
 
 // Whether the keypoint's 5 x 5 neighbourhood shows the person: a depth within `margin_m` of `person_m`.
 // Such a keypoint is behind the person at its centre pixel but on their outline, and its descriptor sees
@@ -95,6 +100,7 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
     }
   }
   const bool use_depth = options.mode == FilterMode::kDepth && depth_m.size() == keypoints.size();
+  std::vector<std::optional<PersonSegment>> segments(grown.size());  // made when first needed
   for (size_t i = 0; i < keypoints.size(); ++i) {
     const cv::Point2f& p = keypoints[i].pt;
     for (size_t b = 0; b < grown.size(); ++b) {
@@ -111,6 +117,16 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
             !(options.silhouettes &&
               on_silhouette(depth_image_raw, depth_factor, keypoints[i], person, options.depth_margin_m, radius)))
           continue;
+        // Close behind the person but off their surface: what the box took in behind them.
+        if (options.segment_from_m > 0 && person > 0 && depth_m[i] > person + options.segment_from_m) {
+          if (!segments[b]) {
+            PersonSegmentOptions segment_options;
+            segment_options.seed_behind_m = options.segment_from_m;
+            segments[b].emplace(depth_image_raw, depth_factor, boxes[static_cast<size_t>(origin[b])].box,
+                                person, options.depth_margin_m, segment_options);
+          }
+          if (segments[b]->cells() > 0 && !segments[b]->near(p, kSegmentRadiusPx)) continue;
+        }
       }
       result.keep[i] = false;
       result.box[i] = origin[b];

@@ -29,6 +29,11 @@ struct KeypointFilterOptions {
   // Depth mode: the quantile of the box's central depths taken as the person's depth (estimate_person_depth).
   // The people stage uses 0.1 with a depth camera's dense depth and 0.3 with stereo's sparse keypoint depths.
   double person_depth_quantile = 0.3;
+  // Depth mode with a dense depth image (RGB-D): a keypoint within the margin behind the person but
+  // more than `segment_from_m` behind them is kept when it is not near the person's surface grown from
+  // their box (person_segment.h): a wall or plant close behind a person, not the person's own back.
+  // 0 = off.
+  double segment_from_m = 0;
   void check() const;
 };
 

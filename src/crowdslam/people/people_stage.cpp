@@ -75,6 +75,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   filter_options_.margin_px = settings.people_filter.margin_px;
   filter_options_.depth_margin_m = settings.people_filter.depth_margin_m;
   filter_options_.silhouettes = settings.people_filter.silhouettes;
+  filter_options_.segment_from_m = settings.people_filter.segment_from_m;
   // Dense depth holds the person wherever they are in the box; stereo's sparse depths hold mismatches, so
   // a low quantile there may be one of them.
   filter_options_.person_depth_quantile = sensor_ == io::SensorKind::kRgbd ? 0.1 : 0.3;
@@ -405,8 +406,11 @@ PeopleFrame PeopleStage::filter(std::size_t index, const io::FrameImages& images
   }
   out.person_boxes = static_cast<int>(area_boxes.size());
   out.keypoints_before_filter = static_cast<int>(raw.keys.size());
+  // The person's surface needs dense depth: RGB-D only (stereo's depth image is its keypoints').
+  KeypointFilterOptions filter_options = filter_options_;
+  if (!rgbd) filter_options.segment_from_m = 0;
   const FilterResult filtered =
-      filter_keypoints(raw.keys, boxes, filter_options_, depth_m, depth_image, depth_factor);
+      filter_keypoints(raw.keys, boxes, filter_options, depth_m, depth_image, depth_factor);
   if (filtered.removed > 0) {
     feature::RawFeatures kept;
     kept.keys.reserve(raw.keys.size() - static_cast<size_t>(filtered.removed));

@@ -301,6 +301,7 @@ nlohmann::json final_document(const RunContext& c, const std::vector<system::Fra
                                          {"flat_box_margin_m", s.people_filter.flat_box_margin_m},
                                          {"mode", s.people_filter.mode},
                                          {"margin_px", s.people_filter.margin_px},
+                                         {"segment_from_m", s.people_filter.segment_from_m},
                                          {"filter_before_nms", people->filter_before_nms()},
                                          {"raw_box_max_area_ratio", s.detector.raw_box_max_area_ratio},
                                          {"raw_boxes_dropped", people->stats().raw_boxes_dropped},
