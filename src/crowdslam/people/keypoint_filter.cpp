@@ -100,7 +100,9 @@ FilterResult filter_keypoints(const std::vector<cv::KeyPoint>& keypoints, const 
     }
   }
   const bool use_depth = options.mode == FilterMode::kDepth && depth_m.size() == keypoints.size();
-  std::vector<std::optional<PersonSegment>> segments(grown.size());  // made when first needed
+  // Each box's surface, made when first needed (nothing is allocated with the rule off, on every frame).
+  std::vector<std::optional<PersonSegment>> segments;
+  if (options.segment_from_m > 0) segments.resize(grown.size());
   for (size_t i = 0; i < keypoints.size(); ++i) {
     const cv::Point2f& p = keypoints[i].pt;
     for (size_t b = 0; b < grown.size(); ++b) {

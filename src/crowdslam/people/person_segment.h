@@ -9,7 +9,6 @@
 // whose depth differs by at most max(step_m, step_ratio x depth) and stays within `window_m` of the
 // person. A floor the person stands on joins the segment at their feet; a wall behind them does not.
 #include <opencv2/core.hpp>
-#include <vector>
 
 namespace crowdslam::people {
 
