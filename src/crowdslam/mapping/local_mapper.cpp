@@ -143,6 +143,16 @@ void LocalMapper::insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe) {
   queue_cv_.notify_one();
 }
 
+void LocalMapper::insert_keyframes(std::shared_ptr<map::KeyFrame> first, std::shared_ptr<map::KeyFrame> second) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    queue_.push_back(std::move(first));
+    queue_.push_back(std::move(second));
+    abort_ba_ = true;
+  }
+  queue_cv_.notify_one();
+}
+
 bool LocalMapper::accepts_keyframes() const { return accepting_ && queued_keyframes() == 0; }
 
 size_t LocalMapper::queued_keyframes() const {
@@ -162,13 +172,6 @@ bool LocalMapper::idle_or_not_working() const {
   return (accepting_ && queue_.empty()) || !worker_active_ || stop_requested_ || pause_requested_;
 }
 
-void LocalMapper::wait_until_points_made(uint64_t keyframe_id, double timeout_ms) {
-  std::unique_lock lock(queue_mutex_);
-  idle_cv_.wait_for(lock, std::chrono::duration<double, std::milli>(timeout_ms), [&] {
-    return (points_made_keyframe_id_ && *points_made_keyframe_id_ >= keyframe_id) || idle_or_not_working();
-  });
-}
-
 bool LocalMapper::has_new_keyframes() const { return queued_keyframes() > 0; }
 
 void LocalMapper::interrupt_bundle_adjustment() { abort_ba_ = true; }
@@ -177,7 +180,6 @@ void LocalMapper::reset() {
   {
     std::lock_guard lock(queue_mutex_);
     queue_.clear();
-    points_made_keyframe_id_.reset();
   }
   recent_points_.clear();
 }
@@ -204,11 +206,6 @@ void LocalMapper::process_keyframe(const std::shared_ptr<map::KeyFrame>& keyfram
   t = Clock::now();
   if (!has_new_keyframes()) fuse_with_neighbours(keyframe);
   const double fusion_ms = ms_since(t);
-  {
-    std::lock_guard lock(queue_mutex_);
-    points_made_keyframe_id_ = keyframe->id;
-  }
-  idle_cv_.notify_all();
   abort_ba_ = false;
   double culling_ms = 0;
   double ba_ms = 0;

@@ -96,10 +96,10 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
 
   // KeyframeConsumer.
   void insert_keyframe(std::shared_ptr<map::KeyFrame> keyframe) override;
+  void insert_keyframes(std::shared_ptr<map::KeyFrame> first, std::shared_ptr<map::KeyFrame> second) override;
   [[nodiscard]] bool accepts_keyframes() const override;
   [[nodiscard]] size_t queued_keyframes() const override;
   bool wait_until_accepting(double timeout_ms) override;
-  void wait_until_points_made(uint64_t keyframe_id, double timeout_ms) override;
   void interrupt_bundle_adjustment() override;
   [[nodiscard]] bool is_paused() const override { return pause_requested_; }
 
@@ -150,7 +150,6 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   std::condition_variable paused_cv_;
   std::condition_variable idle_cv_;  // the worker finished its queue and waits for keyframes
   // The last keyframe whose new points are made (queue_mutex_; idle_cv_ is notified when it changes).
-  std::optional<uint64_t> points_made_keyframe_id_;
   std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done_;
   std::atomic<bool> accepting_{true};
   std::atomic<bool> abort_ba_{false};

@@ -112,16 +112,12 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
   result.keypoints = static_cast<int>(frame.size());
   result.people_share = people_share;
   if (next_frame_wait_ != NextFrameWait::kNone) {
-    // The last frame made a keyframe: this frame is tracked once that keyframe's points exist, as in
-    // sequential mode; otherwise it sees only the points of the keyframe before, one step late (in a
-    // turn, on motion that is already losing the map). After weak tracking it waits for the keyframe's
-    // local BA too; an unpaced replay waits for the new points only, and the BA runs while it tracks.
+    // The last frame made a keyframe: this frame is tracked once the mapper has mapped it (its new
+    // points and its local BA), as in sequential mode; otherwise it sees only the points of the keyframe
+    // before, one step late (in a turn, on motion that is already losing the map), or the new points as
+    // they were before BA (docs/MAPPING.md, "Backpressure").
     const auto wait_start = std::chrono::steady_clock::now();
-    if (next_frame_wait_ == NextFrameWait::kPointsMade && last_keyframe_) {
-      mapper_->wait_until_points_made(last_keyframe_->id, options_.max_wait_for_mapping_ms);
-    } else {
-      mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
-    }
+    mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
     next_frame_wait_ = NextFrameWait::kNone;
     result.waited_for_mapping_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
@@ -351,15 +347,25 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
         create_new_keyframe(frame);
         result.new_keyframe = true;
         if (options_.monocular && options_.max_wait_for_mapping_ms > 0) {
-          next_frame_wait_ = inliers_in_local_map_ < options_.monocular_weak_tracking_inliers
-                                 ? NextFrameWait::kMapped
-                             : options_.monocular_replay_waits ? NextFrameWait::kPointsMade
-                                                               : NextFrameWait::kNone;
+          next_frame_wait_ =
+              inliers_in_local_map_ < options_.monocular_weak_tracking_inliers || options_.monocular_replay_waits
+                  ? NextFrameWait::kMapped
+                  : NextFrameWait::kNone;
         }
       }
       // Outliers are kept until here so that a new keyframe could still use them (as ORB-SLAM2).
       frame.discard_outliers();
       if (!frames_to_retry_.empty()) {
+        if (options_.monocular_replay_waits && options_.max_wait_for_mapping_ms > 0 && result.new_keyframe) {
+          // An unpaced replay localises them in the map as the mapper leaves it after this frame's keyframe
+          // (which the mapper adds to the map's keyframes), not in whatever part of it the mapper has reached.
+          const auto wait_start = std::chrono::steady_clock::now();
+          map_lock.unlock();
+          mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
+          map_lock.lock();
+          result.waited_for_mapping_ms +=
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
+        }
         const auto first = retry_first_keyframe_;
         result.recovered = retry_frames_before_init();
         if (!result.recovered.empty()) result.recovered_reference = first;

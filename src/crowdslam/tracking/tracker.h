@@ -55,7 +55,7 @@ struct TrackerOptions {
   // mode would, so that it makes sequential mode's keyframes with its accuracy and throughput follows the
   // mapper's speed (docs/MAPPING.md, "Backpressure"): a keyframe that is due (the reference ratio)
   // while the mapper is busy is waited for, not skipped, and the frame after a keyframe waits until the
-  // mapper has made that keyframe's new points (its local BA then runs while the frame is tracked). Off
+  // mapper has mapped that keyframe, its local BA included. Off
   // (a paced replay, a live camera): only urgent keyframes are waited for (overdue, weak tracking, under
   // half the reference's points).
   bool monocular_replay_waits = true;
@@ -261,6 +261,7 @@ class Tracker {
   // localised frame once the map has kRetryKeyframes[k] keyframes (the mapper has triangulated more of
   // the first views than the two-view initialisation could). Each frame found is returned once.
   std::vector<std::pair<uint64_t, geometry::SE3>> retry_frames_before_init();
+  [[nodiscard]] bool retry_before_init_due() const;
   enum class KeyframeDecision { kNo, kInsert, kWaitForMapper };
   KeyframeDecision need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);
@@ -375,10 +376,9 @@ class Tracker {
   uint64_t last_relocalization_frame_id_ = 0;
   // The two keyframes the last monocular re-anchoring made (ids; first > second when none).
   std::pair<uint64_t, uint64_t> reanchor_keyframe_ids_{1, 0};
-  // What the next frame waits for after a monocular keyframe (Tracker::track): nothing, the keyframe's
-  // new points (triangulation and fusion; an unpaced replay), or the whole mapping of it, local BA
-  // included (after weak tracking).
-  enum class NextFrameWait { kNone, kPointsMade, kMapped };
+  // What the next frame waits for after a monocular keyframe (Tracker::track): nothing, or the whole
+  // mapping of it, local BA included (an unpaced replay, or after weak tracking).
+  enum class NextFrameWait { kNone, kMapped };
   NextFrameWait next_frame_wait_ = NextFrameWait::kNone;
   int lost_frames_ = 0;                   // consecutive lost frames (new_map_after_lost_min_frames)
   std::optional<double> last_tracked_s_;  // timestamp of the last tracked frame (new_map_after_lost_s)

@@ -34,8 +34,10 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
     return false;
   }
   const auto& [first, second] = *keyframes;
-  track_from_two_views(first, second, frame, map_->map_points());
+  // The earlier frames are localised before the mapper takes the two keyframes: in the map as sequential
+  // mode has it, not in whatever part of it a running mapper has changed.
   recovered_before_init_ = localize_frames_before_init(frame, init->reference->id);
+  track_from_two_views(first, second, frame, map_->map_points());
   frames_before_init_.clear();
   monocular_initializer_.reset();
   return true;
@@ -44,8 +46,9 @@ bool Tracker::initialize_monocular(map::Frame& frame) {
 void Tracker::track_from_two_views(const std::shared_ptr<map::KeyFrame>& first,
                                    const std::shared_ptr<map::KeyFrame>& second, map::Frame& frame,
                                    std::vector<std::shared_ptr<map::MapPoint>> points) {
-  mapper_->insert_keyframe(first);
-  mapper_->insert_keyframe(second);
+  mapper_->insert_keyframes(first, second);
+  // An unpaced replay tracks the next frame once the mapper has mapped both (as after any keyframe).
+  if (options_.monocular_replay_waits && options_.max_wait_for_mapping_ms > 0) next_frame_wait_ = NextFrameWait::kMapped;
   last_keyframe_ = second;
   last_keyframe_frame_id_ = frame.id;
   last_keyframe_indices_.clear();
@@ -82,14 +85,20 @@ std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::localize_frames_before_
   return std::move(around.recovered);
 }
 
+namespace {
+// Frames before the initialisation are tried again when the map has this many keyframes (the two-view
+// map's keyframes are the first two).
+constexpr size_t kRetryKeyframes[] = {4, 8};
+}  // namespace
+
+bool Tracker::retry_before_init_due() const {
+  return !frames_to_retry_.empty() && retries_before_init_ < std::size(kRetryKeyframes) &&
+         map_->num_keyframes() >= kRetryKeyframes[retries_before_init_];
+}
+
 std::vector<std::pair<uint64_t, geometry::SE3>> Tracker::retry_frames_before_init() {
-  // Tried when the map has this many keyframes (the two-view map's keyframes are the first two).
-  constexpr size_t kRetryKeyframes[] = {4, 8};
   std::vector<std::pair<uint64_t, geometry::SE3>> recovered;
-  if (frames_to_retry_.empty() || retries_before_init_ >= std::size(kRetryKeyframes) ||
-      map_->num_keyframes() < kRetryKeyframes[retries_before_init_]) {
-    return recovered;
-  }
+  if (!retry_before_init_due()) return recovered;
   ++retries_before_init_;
   // The first keyframe (the initializer's reference frame) may have moved in bundle adjustment: the frame
   // after the failed ones is placed relative to it.

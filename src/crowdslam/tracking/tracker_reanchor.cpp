@@ -122,16 +122,17 @@ bool Tracker::reanchor(map::Frame& frame, TrackResult& result) {
       "from the {} ({} points)",
       init->reference->id, frame.id, frame.timestamp_s - motion.anchor_s, placement.scale,
       placement.scaled_by_baseline ? "predicted baseline" : "scene depth", second->tracked_map_points(1));
-  track_from_two_views(first, second, frame, second->valid_map_points());
-  frame.discard_outliers();
   // The frames lost before: between the two views, and before the first (backwards from it, skipping
   // those that fail as long as one is localised again within kLocalizeMaxGapS; they are not tried again).
+  // Before the mapper takes the two keyframes, as in sequential mode.
   auto around = localize_around_two_views(
       std::move(frames_since_loss_), first->frame_id, first->cam_from_world(), first->timestamp_s,
       *frame.cam_from_world, frame.timestamp_s, map_->map_points(), options_.pose, kLocalizeMaxGapS);
   frames_since_loss_.clear();
   result.recovered = std::move(around.recovered);
   result.recovered.emplace_back(first->frame_id, first->cam_from_world());
+  track_from_two_views(first, second, frame, second->valid_map_points());
+  frame.discard_outliers();
   result.recovered_reference = first;
   reanchor_keyframe_ids_ = {std::min(first->id, second->id), std::max(first->id, second->id)};
   if (result.recovered.size() > 1) {
