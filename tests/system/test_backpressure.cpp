@@ -37,6 +37,17 @@ struct Outcome {
   io::Trajectory trajectory;
 };
 
+// The synthetic room swept by a monocular camera: 90 frames at 320 x 240, no people.
+void write_sweep(const std::filesystem::path& seq) {
+  synth::SynthOptions synth_options;
+  synth_options.frames = 90;
+  synth_options.width = 320;
+  synth_options.height = 240;
+  synth_options.trajectory = synth::TrajectoryKind::kSweep;
+  synth_options.people = 0;
+  synth::write_sequence(synth_options, seq);
+}
+
 Outcome run(const std::filesystem::path& seq, double max_wait_ms, double mapper_delay_ms) {
   auto dataset = io::open_dataset(seq.string());
   const io::Settings settings = io::load_settings((seq / "settings.yaml").string(), io::SensorKind::kMonocular);
@@ -68,13 +79,7 @@ Outcome run(const std::filesystem::path& seq, double max_wait_ms, double mapper_
 
 TEST(Backpressure, SlowMapperMakesTrackingWaitInsteadOfGoingOnWithoutKeyframes) {
   test::TempDir tmp;
-  synth::SynthOptions synth_options;
-  synth_options.frames = 90;
-  synth_options.width = 320;
-  synth_options.height = 240;
-  synth_options.trajectory = synth::TrajectoryKind::kSweep;
-  synth_options.people = 0;
-  synth::write_sequence(synth_options, tmp / "seq");
+  write_sweep(tmp / "seq");
 
   const Outcome waiting = run(tmp / "seq", 1000.0, 120.0);
   const Outcome ignoring = run(tmp / "seq", 0.0, 120.0);
@@ -100,13 +105,7 @@ TEST(Backpressure, SlowMapperMakesTrackingWaitInsteadOfGoingOnWithoutKeyframes) 
 // differed by millimetres to (in crowds) a collapsed scale.
 TEST(Backpressure, UnpacedMonocularReplayGivesTheSameTrajectoryOnEveryRun) {
   test::TempDir tmp;
-  synth::SynthOptions synth_options;
-  synth_options.frames = 90;
-  synth_options.width = 320;
-  synth_options.height = 240;
-  synth_options.trajectory = synth::TrajectoryKind::kSweep;
-  synth_options.people = 0;
-  synth::write_sequence(synth_options, tmp / "seq");
+  write_sweep(tmp / "seq");
 
   const Outcome fast = run(tmp / "seq", 1000.0, 0.0);
   const Outcome slow = run(tmp / "seq", 1000.0, 15.0);

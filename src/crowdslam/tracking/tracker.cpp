@@ -333,14 +333,9 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
                                   : bridged && !mapper_->is_paused() ? KeyframeDecision::kInsert
                                                                      : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
-        // Local mapping is behind and this frame needs a keyframe: wait for it (map unlocked, so the
-        // mapper can write its bundle adjustment back) rather than track on without new points.
-        const auto wait_start = std::chrono::steady_clock::now();
-        map_lock.unlock();
-        const bool accepting = mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
-        map_lock.lock();
-        result.waited_for_mapping_ms +=
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
+        // Local mapping is behind and this frame needs a keyframe: wait for it rather than track on
+        // without new points.
+        const bool accepting = wait_for_mapper(map_lock, result);
         decision = accepting && !mapper_->is_paused() ? KeyframeDecision::kInsert : KeyframeDecision::kNo;
       }
       if (decision == KeyframeDecision::kInsert) {
@@ -359,12 +354,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
         if (options_.monocular_replay_waits && options_.max_wait_for_mapping_ms > 0 && result.new_keyframe) {
           // An unpaced replay localises them in the map as the mapper leaves it after this frame's keyframe
           // (which the mapper adds to the map's keyframes), not in whatever part of it the mapper has reached.
-          const auto wait_start = std::chrono::steady_clock::now();
-          map_lock.unlock();
-          mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
-          map_lock.lock();
-          result.waited_for_mapping_ms +=
-              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
+          wait_for_mapper(map_lock, result);
         }
         const auto first = retry_first_keyframe_;
         result.recovered = retry_frames_before_init();
@@ -554,6 +544,17 @@ int Tracker::optimize_pose(map::Frame& frame) {
   return inliers;
 }
 
+bool Tracker::wait_for_mapper(std::unique_lock<std::mutex>& map_lock, TrackResult& result) {
+  // The map is unlocked meanwhile, so that the mapper can write its bundle adjustment back.
+  const auto wait_start = std::chrono::steady_clock::now();
+  map_lock.unlock();
+  const bool accepting = mapper_->wait_until_accepting(options_.max_wait_for_mapping_ms);
+  map_lock.lock();
+  result.waited_for_mapping_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wait_start).count();
+  return accepting;
+}
+
 int Tracker::count_tracked_in_map(const map::Frame& frame) const {
   int n = 0;
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
@@ -563,43 +564,8 @@ int Tracker::count_tracked_in_map(const map::Frame& frame) const {
   return n;
 }
 
-bool Tracker::track_with_motion_model(map::Frame& frame) {
-  update_last_frame();
-  frame.cam_from_world = *velocity_ * *last_frame_->cam_from_world;
-  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-  int matches = match::search_from_last_frame(frame, *last_frame_, options_.motion_model_radius);
-  if (matches < 20) {
-    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-    matches = match::search_from_last_frame(frame, *last_frame_, 2 * options_.motion_model_radius);
-  }
-  if (matches < 20) return false;
-  const int inliers = optimize_pose(frame);
-  const int in_map = discard_outliers_count_map_points(frame);
-  if (in_map < 10 && !options_.monocular && options_.odometry_bridge_min_inliers > 0 &&
-      inliers >= options_.odometry_bridge_min_inliers) {
-    odometry_bridge_ = frame;
-  }
-  return in_map >= 10;
-}
-
-bool Tracker::track_reference_keyframe(map::Frame& frame) {
-  if (!reference_keyframe_ || !last_frame_ || !last_frame_->cam_from_world) return false;
-  if (vocabulary_) ensure_bow(frame, *vocabulary_);
-  int matches = 0;
-  if (frame.features->has_bow() && reference_keyframe_->features->has_bow()) {
-    // Bag-of-words guided matching (no pose guess needed).
-    matches = match::search_by_bow(*reference_keyframe_, frame, frame.map_points, 0.7, true);
-  } else {
-    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-    matches = match::search_keyframe_window(frame, *reference_keyframe_, options_.keyframe_window_radius);
-  }
-  if (matches < 15) return false;
-  frame.cam_from_world = *last_frame_->cam_from_world;
-  optimize_pose(frame);
-  return discard_outliers_count_map_points(frame) >= 10;
-}
-
-// The occlusion bridge's motion: tracker_bridge.cpp; local-map tracking: tracker_local_map.cpp; keyframe
+// The occlusion bridge's motion: tracker_bridge.cpp; motion model, reference keyframe and local-map
+// tracking: tracker_local_map.cpp; keyframe
 // decisions and creation, RGB-D / stereo initialisation: tracker_keyframes.cpp;
 // monocular parts: tracker_monocular.cpp.
 

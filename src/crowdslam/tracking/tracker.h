@@ -6,6 +6,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <utility>
 
@@ -262,6 +263,9 @@ class Tracker {
   // the first views than the two-view initialisation could). Each frame found is returned once.
   std::vector<std::pair<uint64_t, geometry::SE3>> retry_frames_before_init();
   [[nodiscard]] bool retry_before_init_due() const;
+  // Waits (bounded) until local mapping takes keyframes, `map_lock` released meanwhile; adds the wait to
+  // result.waited_for_mapping_ms. Returns whether the mapper accepts keyframes.
+  bool wait_for_mapper(std::unique_lock<std::mutex>& map_lock, TrackResult& result);
   enum class KeyframeDecision { kNo, kInsert, kWaitForMapper };
   KeyframeDecision need_new_keyframe_monocular(const map::Frame& frame) const;  // tracker_monocular.cpp
   bool track_with_motion_model(map::Frame& frame);

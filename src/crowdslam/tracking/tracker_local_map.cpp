@@ -1,13 +1,55 @@
-// Tracking the local map (ORB-SLAM2's TrackLocalMap): the keyframes that see the frame's points and their
-// neighbours, their points projected into the frame and matched, and the pose refined on all matches.
+// Tracking a frame against the map: by the motion model (the last frame's points projected from the
+// predicted pose), by the reference keyframe (bag of words), and the local map (ORB-SLAM2's TrackLocalMap):
+// the keyframes that see the frame's points and their neighbours, their points projected into the frame
+// and matched, and the pose refined on all matches.
+#include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "crowdslam/map/map_point.h"
+#include "crowdslam/match/bow_search.h"
 #include "crowdslam/match/orb_matcher.h"
+#include "crowdslam/tracking/frame_bow.h"
+#include "crowdslam/tracking/pose_refinement.h"
 #include "crowdslam/tracking/tracker.h"
 
 namespace crowdslam::tracking {
+
+bool Tracker::track_with_motion_model(map::Frame& frame) {
+  update_last_frame();
+  frame.cam_from_world = *velocity_ * *last_frame_->cam_from_world;
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  int matches = match::search_from_last_frame(frame, *last_frame_, options_.motion_model_radius);
+  if (matches < 20) {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    matches = match::search_from_last_frame(frame, *last_frame_, 2 * options_.motion_model_radius);
+  }
+  if (matches < 20) return false;
+  const int inliers = optimize_pose(frame);
+  const int in_map = discard_outliers_count_map_points(frame);
+  if (in_map < 10 && !options_.monocular && options_.odometry_bridge_min_inliers > 0 &&
+      inliers >= options_.odometry_bridge_min_inliers) {
+    odometry_bridge_ = frame;
+  }
+  return in_map >= 10;
+}
+
+bool Tracker::track_reference_keyframe(map::Frame& frame) {
+  if (!reference_keyframe_ || !last_frame_ || !last_frame_->cam_from_world) return false;
+  if (vocabulary_) ensure_bow(frame, *vocabulary_);
+  int matches = 0;
+  if (frame.features->has_bow() && reference_keyframe_->features->has_bow()) {
+    // Bag-of-words guided matching (no pose guess needed).
+    matches = match::search_by_bow(*reference_keyframe_, frame, frame.map_points, 0.7, true);
+  } else {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    matches = match::search_keyframe_window(frame, *reference_keyframe_, options_.keyframe_window_radius);
+  }
+  if (matches < 15) return false;
+  frame.cam_from_world = *last_frame_->cam_from_world;
+  optimize_pose(frame);
+  return discard_outliers_count_map_points(frame) >= 10;
+}
 
 void Tracker::update_local_map(const map::Frame& frame) {
   // Keyframes that see the frame's points, weighted by how many.
