@@ -149,7 +149,6 @@ class LocalMapper : public tracking::KeyframeConsumer, public loop::LocalMapping
   bool worker_active_ = false;  // the worker thread is running (queue_mutex_)
   std::condition_variable paused_cv_;
   std::condition_variable idle_cv_;  // the worker finished its queue and waits for keyframes
-  // The last keyframe whose new points are made (queue_mutex_; idle_cv_ is notified when it changes).
   std::function<void(const std::shared_ptr<map::KeyFrame>&)> keyframe_done_;
   std::atomic<bool> accepting_{true};
   std::atomic<bool> abort_ba_{false};
