@@ -56,7 +56,12 @@ TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPose
   const auto synth = synth_crowd(seq, "passing", "8", {"--stereo"});
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const auto out = tmp / "run";
-  const auto run = run_sequential(seq, out);
+  // Masks of the raw boxes (Crowd-SLAM's; stereo's default is the NMS boxes), which cover the background
+  // between people: frames then keep too few keypoints to track, and the bridge carries them.
+  const auto settings = tmp / "raw_boxes.yaml";
+  crowdslam::test::write_text(settings,
+                              crowdslam::test::read_text(seq / "settings.yaml") + "\nDetector.filter_before_nms: 1\n");
+  const auto run = run_sequential(seq, out, {"--settings", settings.string()});
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
   const auto& summary = doc["summary"];

@@ -82,7 +82,7 @@ PeopleStage::PeopleStage(const io::Settings& settings, const PeopleStageOptions&
   filter_options_.check();
   right_image_boxes_ = settings.people_filter.right_image == "boxes";
   flat_box_margin_m_ = settings.people_filter.flat_box_margin_m;
-  filter_before_nms_ = settings.detector.filter_before_nms.value_or(sensor_ != io::SensorKind::kMonocular);
+  filter_before_nms_ = settings.detector.filter_before_nms.value_or(sensor_ == io::SensorKind::kRgbd);
   raw_box_max_area_ratio_ = settings.detector.raw_box_max_area_ratio;
   budget_options_.base_features = settings.orb.n_features;
   budget_options_.enabled = settings.feature_budget.enabled;
