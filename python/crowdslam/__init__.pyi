@@ -48,7 +48,7 @@ class DetectorSettings:
     confidence: float
     nms: float
     person_class: int
-    filter_before_nms: Optional[bool]  # None: raw boxes with depth or stereo, NMS boxes monocular
+    filter_before_nms: Optional[bool]  # None: raw boxes with a depth camera, NMS boxes stereo and monocular
 
 class PeopleFilterSettings:
     enabled: bool
