@@ -123,7 +123,7 @@ class PeopleStage {
   AreaMode area_mode_ = AreaMode::kSum;
   BoxFlowOptions flow_options_;
   std::optional<BoxTracker> tracker_;
-  bool filter_before_nms_ = true;  // Settings' filter_before_nms, or its default for the sensor (RGB-D only)
+  bool filter_before_nms_ = true;  // Settings' filter_before_nms; unset: true for RGB-D only
   double raw_box_max_area_ratio_ = 0.0;
   bool right_image_boxes_ = false;
   double flat_box_margin_m_ = 0;

@@ -565,8 +565,7 @@ int Tracker::count_tracked_in_map(const map::Frame& frame) const {
 }
 
 // The occlusion bridge's motion: tracker_bridge.cpp; motion model, reference keyframe and local-map
-// tracking: tracker_local_map.cpp; keyframe
-// decisions and creation, RGB-D / stereo initialisation: tracker_keyframes.cpp;
-// monocular parts: tracker_monocular.cpp.
+// tracking: tracker_local_map.cpp; keyframe decisions and creation, RGB-D / stereo initialisation:
+// tracker_keyframes.cpp; monocular parts: tracker_monocular.cpp.
 
 }  // namespace crowdslam::tracking
