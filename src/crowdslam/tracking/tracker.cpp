@@ -50,6 +50,7 @@ void TrackerOptions::check() const {
   if (!(bridge_near_depth_ratio >= 0 && bridge_near_depth_ratio < 1))
     throw InputError("tracker: bridge_near_depth_ratio must be in [0, 1)");
   if (bridge_resume_min_keypoints < 0) throw InputError("tracker: bridge_resume_min_keypoints must be >= 0");
+  if (!(bridge_resume_recent_s >= 0)) throw InputError("tracker: bridge_resume_recent_s must be >= 0");
   if (!(bridge_gate_base_m >= 0 && bridge_gate_m_per_s >= 0 && bridge_gate_base_deg >= 0 &&
         bridge_gate_deg_per_s >= 0)) {
     throw InputError("tracker: bridge_gate_* must be >= 0");
@@ -256,6 +257,11 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       const auto max_points = static_cast<size_t>(options_.bridge_resume_max_map_points);
       if (!hidden) {
         resumes = map_points_in_view < max_points;
+        if (!resumes && frame.timestamp_s - motion->anchor_s <= options_.bridge_resume_recent_s) {
+          spdlog::debug("frame {}: mapping goes on from a bridge of {:.2f} s ({} map points in view)", frame.id,
+                        frame.timestamp_s - motion->anchor_s, map_points_in_view);
+          resumes = true;
+        }
       } else if (options_.bridge_resume_min_keypoints > 0 &&
                  background_keypoints(frame) >= static_cast<size_t>(options_.bridge_resume_min_keypoints)) {
         map::Frame at_bridge = frame;

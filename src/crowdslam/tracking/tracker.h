@@ -122,6 +122,11 @@ struct TrackerOptions {
   // the frame is lost and relocalised instead: the map is there, and a keyframe at a drifted pose would
   // contradict it.
   int bridge_resume_max_map_points = 100;
+  // ... or, with the view clear, where the bridge is this recent (its anchor, below, at most this long
+  // before the frame): a pose a few frames old has drifted by millimetres, and a frame that fails there
+  // failed on its own evidence (a person the detector missed, the map's points hidden behind it), which
+  // the frames after it, tracked from its keyframe, recover from (0 = off).
+  double bridge_resume_recent_s = 0.2;
   // ... and while people still cover at least bridge_min_people_share of the keypoints, when the frame
   // has at least this many keypoints with depth outside the person boxes (and not near, below): then the map points in view are
   // counted only where the frame has keypoints (a person in front hides the others), so a strip of
