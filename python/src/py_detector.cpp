@@ -5,6 +5,7 @@
 
 #include "crowdslam/io/settings.h"
 #include "crowdslam/people/darknet_detector.h"
+#include "crowdslam/people/detector_setup.h"
 #include "crowdslam/people/model_paths.h"
 #include "py_arrays.h"
 #include "py_bindings.h"
@@ -20,20 +21,20 @@ class PyDetector {
   PyDetector(const std::optional<std::string>& model, const std::optional<std::string>& settings,
              std::optional<int> input_size, std::optional<double> confidence, std::optional<double> nms,
              std::optional<int> person_class) {
-    people::ModelFiles files = people::resolve_model(model.value_or("body"));
-    people::DetectorOptions options;
-    if (settings) {
-      const io::DetectorSettings d = io::load_settings(*settings, io::SensorKind::kMonocular).detector;
-      options.input_size = d.input_size;
-      options.confidence = d.confidence;
-      options.nms = d.nms;
-      options.person_class = d.person_class;
-      if (!model && !d.model_cfg.empty()) files = {d.model_cfg, d.model_weights, d.person_class};
+    // The model and options as `crowdslam run` and `crowdslam detect` build them (people/detector_setup.h):
+    // `model` first, else the settings' Detector.model_cfg (a zoo name or a path), else "body".
+    io::DetectorSettings d;
+    if (settings) d = io::load_settings(*settings, io::SensorKind::kMonocular).detector;
+    people::DetectorSetup setup = people::detector_setup(d, model.value_or(""));
+    people::ModelFiles files = std::move(setup.model);
+    people::DetectorOptions options = setup.options;
+    if (input_size) {  // square, over the settings' WIDTHxHEIGHT
+      options.input_size = *input_size;
+      options.input_width = options.input_height = 0;
     }
-    if (input_size) options.input_size = *input_size;
     if (confidence) options.confidence = *confidence;
     if (nms) options.nms = *nms;
-    if (person_class) options.person_class = *person_class;
+    if (person_class) files.person_class = options.person_class = *person_class;
     options.check();
     // Loads the network and runs a warm-up forward pass.
     detector_ = without_gil([&] { return std::make_unique<people::DarknetDetector>(files, options); });

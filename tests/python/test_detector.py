@@ -47,3 +47,28 @@ def test_detect_errors() -> None:
         crowdslam.Detector("/nonexistent/nope.cfg")
     with pytest.raises(crowdslam.InputError, match="confidence"):
         crowdslam.Detector(confidence=2.0)
+
+
+def test_settings_model_by_name_equals_cli(synth_sequence: Path, tmp_path: Path) -> None:
+    # A settings file naming a zoo model (Detector.model_cfg: yolox) with its own input and thresholds:
+    # crowdslam.Detector(settings=...) resolves it as `crowdslam detect --settings` does.
+    settings = tmp_path / "yolox.yaml"
+    settings.write_text((synth_sequence / "settings.yaml").read_text() +
+                        "\nDetector.model_cfg: yolox\nDetector.input_width: 256\nDetector.input_height: 192\n"
+                        "Detector.confidence: 0.25\nDetector.nms: 0.4\nDetector.filter_before_nms: 0\n")
+    out = tmp_path / "det.txt"
+    run_cli("--quiet", "detect", "--dataset", str(synth_sequence), "--out", str(out), "--max-frames", str(FRAMES),
+            "--settings", str(settings))
+    rows = np.loadtxt(out, delimiter=",", ndmin=2)
+    detector = crowdslam.Detector(settings=str(settings))
+    assert "yolox" in detector.name.lower()
+    seq = crowdslam.datasets.open(synth_sequence)
+    total = 0
+    for i in range(FRAMES):
+        boxes, scores = detector.detect(seq[i].image)
+        expected = rows[rows[:, 0] == i + 1] if len(rows) else np.zeros((0, 10))
+        assert len(boxes) == len(expected), f"frame {i}"
+        np.testing.assert_allclose(boxes, expected[:, 2:6], rtol=1e-5, atol=1e-3)
+        np.testing.assert_allclose(scores, expected[:, 6], rtol=1e-5, atol=1e-6)
+        total += len(boxes)
+    assert total > 0
