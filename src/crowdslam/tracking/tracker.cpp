@@ -51,6 +51,8 @@ void TrackerOptions::check() const {
     throw InputError("tracker: bridge_near_depth_ratio must be in [0, 1)");
   if (bridge_resume_min_keypoints < 0) throw InputError("tracker: bridge_resume_min_keypoints must be >= 0");
   if (!(bridge_resume_recent_s >= 0)) throw InputError("tracker: bridge_resume_recent_s must be >= 0");
+  if (bridge_resume_min_depth_keypoints < 0)
+    throw InputError("tracker: bridge_resume_min_depth_keypoints must be >= 0");
   if (!(bridge_gate_base_m >= 0 && bridge_gate_m_per_s >= 0 && bridge_gate_base_deg >= 0 &&
         bridge_gate_deg_per_s >= 0)) {
     throw InputError("tracker: bridge_gate_* must be >= 0");
@@ -253,9 +255,12 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     const bool hidden = people_share >= options_.bridge_min_people_share ||
                         (!ok && !options_.monocular && near_occluder_share(frame) >= options_.bridge_min_people_share);
     bool resumes = false;
+    bool without_depth = false;  // the view has cleared, but the frame has too little depth to map on from
     if (!ok && after_bridge && motion && !options_.monocular && !localization_only_) {
       const auto max_points = static_cast<size_t>(options_.bridge_resume_max_map_points);
-      if (!hidden) {
+      if (!hidden && background_keypoints(frame) < static_cast<size_t>(options_.bridge_resume_min_depth_keypoints)) {
+        without_depth = true;  // bridged on: the next frames may have the depth
+      } else if (!hidden) {
         resumes = map_points_in_view < max_points;
         if (!resumes && frame.timestamp_s - motion->anchor_s <= options_.bridge_resume_recent_s) {
           spdlog::debug("frame {}: mapping goes on from a bridge of {:.2f} s ({} map points in view)", frame.id,
@@ -269,8 +274,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
         resumes = map_points_near_keypoints(at_bridge) < max_points;
       }
     }
-    const bool occluded =
-        !ok && (hidden || resumes) && (was_tracking || after_bridge) && bridge(frame, start_motion());
+    const bool occluded = !ok && (hidden || resumes || without_depth) && (was_tracking || after_bridge) &&
+                          bridge(frame, start_motion());
     if (occluded && resumes) {
       ok = bridged = resumed = true;  // a keyframe below
       result.method = "bridged";

@@ -127,6 +127,11 @@ struct TrackerOptions {
   // failed on its own evidence (a person the detector missed, the map's points hidden behind it), which
   // the frames after it, tracked from its keyframe, recover from (0 = off).
   double bridge_resume_recent_s = 0.2;
+  // ... and only from a frame with at least this many keypoints with depth off the people (and not near):
+  // a frame after a bridge with fewer (stereo finds no match on a view still blurred or half covered) has
+  // nothing to map on with, and is bridged on instead of lost (within bridge_max_s), so that the next
+  // frames, which have the depth, can resume (0 = off).
+  int bridge_resume_min_depth_keypoints = 50;
   // ... and while people still cover at least bridge_min_people_share of the keypoints, when the frame
   // has at least this many keypoints with depth outside the person boxes (and not near, below): then the map points in view are
   // counted only where the frame has keypoints (a person in front hides the others), so a strip of
