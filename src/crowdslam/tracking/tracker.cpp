@@ -258,13 +258,15 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     bool without_depth = false;  // the view has cleared, but the frame has too little depth to map on from
     if (!ok && after_bridge && motion && !options_.monocular && !localization_only_) {
       const auto max_points = static_cast<size_t>(options_.bridge_resume_max_map_points);
-      if (!hidden && background_keypoints(frame) < static_cast<size_t>(options_.bridge_resume_min_depth_keypoints)) {
-        without_depth = true;  // bridged on: the next frames may have the depth
-      } else if (!hidden) {
-        resumes = map_points_in_view < max_points;
-        if (!resumes && frame.timestamp_s - motion->anchor_s <= options_.bridge_resume_recent_s) {
+      if (!hidden) {
+        const double bridge_age_s = frame.timestamp_s - motion->anchor_s;
+        if (background_keypoints(frame) < static_cast<size_t>(options_.bridge_resume_min_depth_keypoints)) {
+          without_depth = true;  // bridged on: the next frames may have the depth
+        } else if (map_points_in_view < max_points) {
+          resumes = true;
+        } else if (options_.bridge_resume_recent_s > 0 && bridge_age_s <= options_.bridge_resume_recent_s) {
           spdlog::debug("frame {}: mapping goes on from a bridge of {:.2f} s ({} map points in view)", frame.id,
-                        frame.timestamp_s - motion->anchor_s, map_points_in_view);
+                        bridge_age_s, map_points_in_view);
           resumes = true;
         }
       } else if (options_.bridge_resume_min_keypoints > 0 &&

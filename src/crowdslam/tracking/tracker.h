@@ -122,21 +122,22 @@ struct TrackerOptions {
   // the frame is lost and relocalised instead: the map is there, and a keyframe at a drifted pose would
   // contradict it.
   int bridge_resume_max_map_points = 100;
-  // ... or, with the view clear, where the bridge is this recent (its anchor, below, at most this long
-  // before the frame): a pose a few frames old has drifted by millimetres, and a frame that fails there
-  // failed on its own evidence (a person the detector missed, the map's points hidden behind it), which
-  // the frames after it, tracked from its keyframe, recover from (0 = off).
-  double bridge_resume_recent_s = 0.2;
-  // ... and only from a frame with at least this many keypoints with depth off the people (and not near):
-  // a frame after a bridge with fewer (stereo finds no match on a view still blurred or half covered) has
-  // nothing to map on with, and is bridged on instead of lost (within bridge_max_s), so that the next
-  // frames, which have the depth, can resume (0 = off).
-  int bridge_resume_min_depth_keypoints = 50;
   // ... and while people still cover at least bridge_min_people_share of the keypoints, when the frame
   // has at least this many keypoints with depth outside the person boxes (and not near, below): then the map points in view are
   // counted only where the frame has keypoints (a person in front hides the others), so a strip of
   // background between people that the map never saw carries tracking on (0 = only when the view clears).
   int bridge_resume_min_keypoints = 150;
+  // With depth and the view clear, mapping also goes on from the bridged pose where the map does hold
+  // the view when the bridge is this recent (its anchor, below, at most this long before the frame): a
+  // pose a few frames old has drifted by millimetres, and a frame that fails there failed on its own
+  // evidence (a person the detector missed, the map's points hidden behind it), which the frames after
+  // it, tracked from its keyframe, recover from (0 = off).
+  double bridge_resume_recent_s = 0.2;
+  // With depth and the view clear, a frame after a bridge with fewer than this many keypoints with depth
+  // off the people (and not near) has nothing to map on with (stereo finds no match on a view still
+  // blurred or half covered): it is bridged on instead of resumed or lost (within bridge_max_s), so that
+  // the next frames, which have the depth, can resume (0 = off).
+  int bridge_resume_min_depth_keypoints = 50;
   // With depth, a frame tracked after bridged frames is rejected (still bridged) when its pose differs
   // from the bridge's by more than base + rate x the time since the bridge's anchor: the bridge drifts a
   // few centimetres in a second, a pose from matches on a missed person or on look-alike texture by
