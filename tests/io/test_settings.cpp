@@ -309,7 +309,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadValue{"PeopleFilter.static_check_below", "PeopleFilter.static_check_below: -1",
                  "PeopleFilter.static_check_below: must be >= 0"},
         BadValue{"PeopleFilter.static_in_boxes", "PeopleFilter.static_in_boxes: \"sometimes\"",
-                 "PeopleFilter.static_in_boxes: must be \"monocular\", \"always\" or \"never\""},
+                 "PeopleFilter.static_in_boxes: must be \"auto\", \"monocular\", \"always\" or \"never\""},
         BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.odometry_bridge_min_inliers: -1",
                  "Tracking.odometry_bridge_min_inliers: must be >= 0 (0 = off)"},
         BadValue{"Detector.nms", "Detector.nms: 0.1\nTracking.odometry_bridge_min_inliers: 1.5",

@@ -1,8 +1,9 @@
 // End-to-end: a false-positive box covering nearly the whole image of a static synthetic room costs no
 // tracking, two ways: keypoints in person boxes taken back by the static map (tracking/box_keypoints.cpp,
 // PeopleFilter.static_in_boxes "always"), and the RGB-D default, the depth test that finds the box flat
-// (people/box_depth.h). With neither (static_in_boxes off, flat_box_margin_m 0) the same box loses the
-// camera.
+// (people/box_depth.h). With neither (static_in_boxes "never", flat_box_margin_m 0) the same box loses the
+// camera; with the default "auto" and no depth test, the frames the filter leaves too little are taken
+// back with their box keypoints.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -32,7 +33,7 @@ std::filesystem::path make_room(const test::TempDir& tmp) {
   return dir;
 }
 
-// `static_in_boxes` empty: the settings' default ("monocular": not used in this RGB-D run).
+// `static_in_boxes` empty: the settings' default ("auto": with depth, only for frames the filter fails).
 // `flat_box_margin_m` < 0: the settings' default.
 run::RunSummary run_room(const std::filesystem::path& dataset, const std::filesystem::path& out,
                          const std::string& static_in_boxes, double flat_box_margin_m = -1.0) {
@@ -86,11 +87,10 @@ TEST(RunBoxKeypoints, AFalsePositiveOverNearlyTheWholeImageCostsNoTracking) {
   EXPECT_GE(frames_with_box_matches, kLastBoxFrame - kFirstBoxFrame);
   EXPECT_EQ(people["frames_with_box_matches"].get<int>(), frames_with_box_matches);
 
-  // The RGB-D defaults: box keypoints unused (monocular only), but the box lies on the room's walls and
-  // furniture with nothing standing out of them, so the depth test drops it and the frames keep their
-  // keypoints.
+  // The RGB-D defaults: the box lies on the room's walls and furniture with nothing standing out of them,
+  // so the depth test drops it and the frames keep their keypoints (box keypoints, "auto", are not needed).
   const auto defaults = run_room(dataset, tmp / "default", "");
-  EXPECT_EQ(defaults.json["people_filter"]["static_in_boxes"], "monocular");
+  EXPECT_EQ(defaults.json["people_filter"]["static_in_boxes"], "auto");
   EXPECT_EQ(defaults.tracked, static_cast<size_t>(kFrames));
   EXPECT_EQ(defaults.json["summary"]["map_resets"].get<int>(), 0);
   ASSERT_TRUE(defaults.ate_rmse_m.has_value());
@@ -105,8 +105,28 @@ TEST(RunBoxKeypoints, AFalsePositiveOverNearlyTheWholeImageCostsNoTracking) {
   }
 
   // Neither: the filtered frames have too little left and the camera is lost.
-  const auto neither = run_room(dataset, tmp / "neither", "", 0.0);
+  const auto neither = run_room(dataset, tmp / "neither", "never", 0.0);
   EXPECT_LT(neither.tracked, static_cast<size_t>(kFrames) - 5);
   EXPECT_EQ(neither.json["people_filter"]["flat_boxes"].get<int>(), 0);
   EXPECT_EQ(neither.json["people_filter"]["frames_with_box_matches"].get<int>(), 0);
+
+  // The default box keypoints with depth ("auto"), the depth test off: the frames that fail on what the
+  // filter leaves are taken back with their box keypoints, no box is released into the map, and no other
+  // frame uses them.
+  const auto rescue = run_room(dataset, tmp / "auto", "auto", 0.0);
+  EXPECT_EQ(rescue.tracked, static_cast<size_t>(kFrames));
+  EXPECT_EQ(rescue.json["summary"]["map_resets"].get<int>(), 0);
+  ASSERT_TRUE(rescue.ate_rmse_m.has_value());
+  EXPECT_LT(*rescue.ate_rmse_m, 0.02);
+  int rescued = 0;
+  for (const auto& f : rescue.json["frames"]) {
+    const int index = f["index"].get<int>();
+    EXPECT_EQ(f["static_boxes"].get<int>(), 0) << "frame " << index;
+    if (f["box_matches"].get<int>() == 0) continue;
+    // Box matches only where the filtered keypoints failed: the frame is reported rescued.
+    EXPECT_EQ(f["method"], "motion+boxes") << "frame " << index;
+    EXPECT_TRUE(index >= kFirstBoxFrame && index <= kLastBoxFrame) << "frame " << index;
+    ++rescued;
+  }
+  EXPECT_GE(rescued, kLastBoxFrame - kFirstBoxFrame);
 }

@@ -99,9 +99,11 @@ struct PeopleFilterSettings {
   // the filtered frame tracks fewer than static_check_below points or fails (tracking/tracker.h,
   // box_keypoints.cpp): a false-positive box over most of the image, or background a person box hides,
   // then costs no tracking. Nothing in the map is made of them.
-  // "monocular" (default): with --sensor mono only, where a box hides the background behind a person
-  // (no depth mode to keep it); "always"; "never". Measured in docs/CROWDS.md.
-  std::string static_in_boxes = "monocular";
+  // "auto" (default): with --sensor mono on a weak or failed frame, where a box hides the background
+  // behind a person (no depth mode to keep it); with depth only on a frame the filtered keypoints fail on
+  // (not within a second after a bridged frame). "monocular": with --sensor mono only; "always": every
+  // sensor, weak or failed frames; "never". Measured in docs/CROWDS.md.
+  std::string static_in_boxes = "auto";
   int static_check_below = 150;
   // RGB-D: a box whose torso region is not closer than the surface around the box by more than this is
   // flat (a poster, a wall photograph, a screen; people/box_depth.h) and filters nothing. 0 = off.

@@ -201,8 +201,9 @@ void check_own_sections(const Checker& c, const Settings& s) {
   c.require(p.static_check_below >= 0, "PeopleFilter.static_check_below", ">= 0", p.static_check_below);
   c.require(std::isfinite(p.flat_box_margin_m) && p.flat_box_margin_m >= 0, "PeopleFilter.flat_box_margin_m",
             ">= 0", p.flat_box_margin_m);
-  c.require(p.static_in_boxes == "monocular" || p.static_in_boxes == "always" || p.static_in_boxes == "never",
-            "PeopleFilter.static_in_boxes", "\"monocular\", \"always\" or \"never\"",
+  c.require(p.static_in_boxes == "auto" || p.static_in_boxes == "monocular" || p.static_in_boxes == "always" ||
+                p.static_in_boxes == "never",
+            "PeopleFilter.static_in_boxes", "\"auto\", \"monocular\", \"always\" or \"never\"",
             "\"" + p.static_in_boxes + "\"");
   const auto& g = s.geometry;
   c.require(std::isfinite(g.moving_factor) && g.moving_factor > 0, "Geometry.moving_factor", "> 0",

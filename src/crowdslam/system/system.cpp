@@ -79,9 +79,19 @@ System::System(const io::Settings& settings, const SystemOptions& options)
   tracking::TrackerOptions tracker_options;
   tracker_options.close_depth_m = close_depth_m;
   const std::string& in_boxes = settings.people_filter.static_in_boxes;
-  tracker_options.box_keypoints =
-      in_boxes == "always" || (in_boxes == "monocular" && options.sensor == io::SensorKind::kMonocular);
+  const bool mono = options.sensor == io::SensorKind::kMonocular;
+  tracker_options.box_keypoints = in_boxes == "always" || in_boxes == "auto" || (in_boxes == "monocular" && mono);
   tracker_options.box_check_below = settings.people_filter.static_check_below;
+  if (in_boxes == "auto" && !mono) {
+    // With depth, only a frame the filtered keypoints fail on, near the motion model's pose, and nothing
+    // of it mapped (docs/CROWDS.md#box-keypoints-taken-back-by-the-static-map).
+    tracker_options.box_check_below = 0;
+    tracker_options.box_release = false;
+    tracker_options.box_rescue_keyframes = false;
+    tracker_options.box_rescue_gate_m = 0.05;
+    tracker_options.box_rescue_gate_deg = 1.5;
+    tracker_options.box_rescue_after_bridge_s = 1.0;
+  }
   tracker_options.box_rescue = true;
   tracker_options.max_wait_for_mapping_ms = options.sequential ? 0.0 : options.max_wait_for_mapping_ms;
   tracker_options.monocular_replay_waits = options.replay_waits_for_mapping;

@@ -36,7 +36,10 @@ const char* to_string(TrackingState state) {
 
 void TrackerOptions::check() const {
   if (!(close_depth_m > 0)) throw InputError("tracker: close depth (ThDepth) must be > 0");
-  if (min_init_features < 10) throw InputError("tracker: min_init_features must be >= 10");
+  if (min_init_features < 10 || min_init_static_features < 10)
+    throw InputError("tracker: min_init_features and min_init_static_features must be >= 10");
+  if (!(box_rescue_after_bridge_s >= 0) || !(box_rescue_gate_m >= 0) || !(box_rescue_gate_deg >= 0))
+    throw InputError("tracker: box_rescue_after_bridge_s and box_rescue_gate_* must be >= 0");
   if (max_frames_between_keyframes < 1)
     throw InputError("tracker: max frames between keyframes must be >= 1");
   if (keyframe_reference_min_observations < 1)
@@ -76,6 +79,7 @@ void Tracker::reset() {
   lost_frames_ = 0;
   last_tracked_s_.reset();
   last_bridged_s_.reset();
+  bridged_seen_s_.reset();
   bridge_motion_.reset();
   bridge_recent_motion_.reset();
   reanchor_.reset();
@@ -129,7 +133,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
 
   bool resumed = false;  // mapping went on from a bridged pose: tracking continues, the frame is reported bridged
   if (state_ == TrackingState::kNotInitialized) {
-    if (options_.monocular ? initialize_monocular(frame) : initialize(frame)) {
+    if (options_.monocular ? initialize_monocular(frame) : initialize(frame, people_share)) {
       state_ = TrackingState::kOk;
       result.method = "init";
       result.new_keyframe = true;
@@ -219,8 +223,11 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
     // While bridged, the keypoints in boxes are searched from where the bridge puts the frame: a person
     // close to a monocular camera hides the map outside the boxes, not behind them.
     if (!ok && after_bridge && motion && !bridged_guess) bridged_guess = motion->at(frame.timestamp_s);
+    // A frame moments after a bridge is left to the bridge (box_rescue_after_bridge_s).
+    const bool rescue_waits = options_.box_rescue_after_bridge_s > 0 && bridged_seen_s_ &&
+                              std::abs(frame.timestamp_s - *bridged_seen_s_) < options_.box_rescue_after_bridge_s;
     if (boxes && options_.box_keypoints &&
-        (ok ? inliers_in_local_map_ < options_.box_check_below : was_tracking || bridged_guess)) {
+        (ok ? inliers_in_local_map_ < options_.box_check_below : (was_tracking || bridged_guess) && !rescue_waits)) {
       if (auto full = with_box_keypoints(frame, ok, boxes, result.static_boxes, bridged_guess)) {
         if (!ok) {
           result.method = "motion+boxes";
@@ -241,7 +248,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       result.method = "odometry";
     }
     odometry_bridge_.reset();
-    if (!ok && boxes && options_.box_keypoints && !was_tracking) {
+    if (!ok && boxes && options_.box_keypoints && !was_tracking && !rescue_waits) {
       // Lost, and the filter left too little to relocalise: the whole image may still show the map.
       if (auto full = relocalize_with_box_keypoints(frame, boxes)) {
         frame = std::move(*full);
@@ -342,7 +349,8 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       }
       temporal_points_.clear();
       // A bridged frame is a keyframe whenever one can be made: the map has no points where it looks.
-      KeyframeDecision decision = localization_only_                 ? KeyframeDecision::kNo
+      KeyframeDecision decision = localization_only_ || (result.rescued_with_boxes && !options_.box_rescue_keyframes)
+                                      ? KeyframeDecision::kNo
                                   : bridged && !mapper_->is_paused() ? KeyframeDecision::kInsert
                                                                      : need_new_keyframe(frame);
       if (decision == KeyframeDecision::kWaitForMapper) {
@@ -379,6 +387,7 @@ TrackResult Tracker::track(map::Frame frame, const BoxKeypoints& boxes, double p
       if (!after_bridge) bridge_recent_motion_ = last_frame_motion(frame, velocity_at_start);
       bridge_motion_ = motion;
       last_bridged_s_ = frame.timestamp_s;
+      bridged_seen_s_ = frame.timestamp_s;
       lost_frames_ = 0;
       result.bridged_cam_from_world = frame.cam_from_world;
       // Monocular, onto a view the map does not hold with background to see: a two-view map there now

@@ -34,6 +34,9 @@ const char* to_string(TrackingState state);
 struct TrackerOptions {
   double close_depth_m = 3.0;             // "close" points (ThDepth * baseline): reliable depth
   int min_init_features = 500;            // keypoints with depth needed to initialise (RGB-D)
+  // Where the people filter took a share s of the frame's keypoints, min_init_features x (1 - s) of them
+  // (as many as the frame would need before the filter), and at least this many.
+  int min_init_static_features = 150;
   int max_frames_between_keyframes = 30;  // usually the camera fps
   // Backpressure: when a keyframe is needed urgently and local mapping is behind, tracking waits for it
   // up to this long (with the map unlocked) instead of going on without the keyframe and losing track.
@@ -161,8 +164,19 @@ struct TrackerOptions {
   int box_check_below = 150;
   int box_min_observations = 2;
   int box_rescue_min_inliers = 50;
-  // Whether box keypoints may track a frame the filtered keypoints failed on (System: monocular only).
+  // Whether box keypoints may track a frame the filtered keypoints failed on.
   bool box_rescue = true;
+  // A frame that only box keypoints could place ("auto" with depth, System): the first three below off
+  // and the last two set, its box keypoints place it and nothing else. Person points the map holds can
+  // outvote the background's (a rescued keyframe's pose drifted 0.3 m in local BA).
+  bool box_release = true;          // a box the evidence shows static is released (release_static_boxes)
+  bool box_rescue_keyframes = true;  // a frame taken back by box keypoints may become a keyframe
+  // Its pose must lie within this of the motion model's (0 = no limit).
+  double box_rescue_gate_m = 0.0;
+  double box_rescue_gate_deg = 0.0;
+  // Not within this long after the last bridged frame (0 = no limit): after a bridge the map holds points
+  // mapped on from the bridged pose, and such a frame is left to the bridge and its resume rules.
+  double box_rescue_after_bridge_s = 0.0;
   optim::PoseOptimizerOptions pose;
   // Geometric dynamic check of the tracked keypoints (dynamic_check.h).
   DynamicCheckOptions dynamic;
@@ -259,7 +273,7 @@ class Tracker {
   void reset();
 
  private:
-  bool initialize(map::Frame& frame);
+  bool initialize(map::Frame& frame, double people_share);
   bool initialize_monocular(map::Frame& frame);  // tracker_monocular.cpp
   // The two keyframes of a two-view map (initialisation or re-anchoring) to the mapper; tracking goes on
   // from the second, with `points` as the local map (tracker_monocular.cpp).
@@ -324,6 +338,9 @@ class Tracker {
   // With depth: whether the frame's pose, found after bridged frames, is within what the bridge's motion
   // can have drifted since its anchor (TrackerOptions::bridge_gate_*).
   [[nodiscard]] bool agrees_with_bridge(const map::Frame& frame, const BridgeMotion& motion) const;
+  // Whether a pose from box keypoints is within TrackerOptions::box_rescue_gate_* of the motion model's
+  // `predicted` pose (box_keypoints.cpp).
+  [[nodiscard]] bool within_rescue_gate(const geometry::SE3& cam_from_world, const geometry::SE3& predicted) const;
   // On from the last frame at `velocity` (its velocity when the frame came).
   [[nodiscard]] std::optional<BridgeMotion> last_frame_motion(const map::Frame& frame,
                                                               const std::optional<geometry::SE3>& velocity) const;
@@ -416,6 +433,7 @@ class Tracker {
   std::deque<RecentPose> recent_poses_;  // the last tracked frames (bridge_motion)
   double scene_depth_m_ = 0;  // median depth of the last tracked frame's inliers (0: unknown)
   std::optional<double> last_bridged_s_;          // timestamp of the last bridged frame (the lost clock)
+  std::optional<double> bridged_seen_s_;          // the same, kept after tracking resumes (box_rescue_after_bridge_s)
   int inliers_in_local_map_ = 0;
   size_t projected_local_points_ = 0;  // local map points in view in the last track_local_map
   bool map_loaded_ = false;

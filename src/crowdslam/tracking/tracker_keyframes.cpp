@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "crowdslam/map/map_point.h"
@@ -144,14 +145,20 @@ void Tracker::create_new_keyframe(map::Frame& frame) {
 }
 
 // ---- initialisation (RGB-D / stereo: one frame with depth) ----
-bool Tracker::initialize(map::Frame& frame) {
+bool Tracker::initialize(map::Frame& frame, double people_share) {
   if (vocabulary_) ensure_bow(frame, *vocabulary_);  // the first keyframe carries its bag of words
   const auto& f = *frame.features;
   int with_depth = 0;
   for (size_t i = 0; i < f.size(); ++i) {
     if (f.depth_m[i] > 0) ++with_depth;
   }
-  if (with_depth < options_.min_init_features) return false;
+  // A crowd takes part of the view: the frame needs what it would before the filter (ORB-SLAM2's 500 of
+  // 1,000 keypoints, a textured enough view) in proportion to what the filter left.
+  const double left = 1.0 - std::clamp(people_share, 0.0, 1.0);
+  const int needed = std::min(options_.min_init_features,
+                              std::max(options_.min_init_static_features,
+                                       static_cast<int>(std::ceil(options_.min_init_features * left))));
+  if (with_depth < needed) return false;
 
   frame.cam_from_world = geometry::SE3::identity();
   auto keyframe =
