@@ -46,6 +46,22 @@ crowdslam::test::CliResult run_sequential(const fs::path& seq, const fs::path& o
   args.insert(args.end(), extra.begin(), extra.end());
   return run_cli(args);
 }
+
+// run_sequential's run.json; null (and a test failure) when the run failed.
+nlohmann::json run_json(const fs::path& seq, const fs::path& out, const std::vector<std::string>& extra = {}) {
+  const auto run = run_sequential(seq, out, extra);
+  if (run.exit_code != 0) {
+    ADD_FAILURE() << "crowdslam run exited with " << run.exit_code << ": " << run.err;
+    return nullptr;
+  }
+  return nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+}
+
+// `seq`'s settings with `extra` lines after them, written to `path`: the --settings arguments.
+std::vector<std::string> settings_with(const fs::path& seq, const fs::path& path, const std::string& extra) {
+  crowdslam::test::write_text(path, crowdslam::test::read_text(seq / "settings.yaml") + "\n" + extra);
+  return {"--settings", path.string()};
+}
 }  // namespace
 
 
@@ -55,17 +71,14 @@ TEST(RunCrowdBridge, StereoCrowdMapsTheBackgroundBetweenPeopleFromTheBridgedPose
   const auto seq = tmp / "crowd";
   const auto synth = synth_crowd(seq, "passing", "8", {"--stereo"});
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  const auto out = tmp / "run";
   // Masks of the raw boxes (Crowd-SLAM's; stereo's default is the NMS boxes), which cover the background
   // between people: frames then keep too few keypoints to track, and the bridge carries them. Box
   // keypoints off (by default they take back frames the map holds the background of): the bridge is what
   // this test measures.
-  const auto settings = tmp / "raw_boxes.yaml";
-  crowdslam::test::write_text(settings, crowdslam::test::read_text(seq / "settings.yaml") +
-                                            "\nDetector.filter_before_nms: 1\nPeopleFilter.static_in_boxes: \"monocular\"\n");
-  const auto run = run_sequential(seq, out, {"--settings", settings.string()});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  const auto doc = run_json(
+      seq, tmp / "run",
+      settings_with(seq, tmp / "raw_boxes.yaml", "Detector.filter_before_nms: 1\nPeopleFilter.static_in_boxes: \"monocular\"\n"));
+  ASSERT_FALSE(doc.is_null());
   const auto& summary = doc["summary"];
   EXPECT_EQ(summary["map_resets"].get<int>(), 0);
   // Frames that made a keyframe from the bridged pose while people still covered half the keypoints or
@@ -105,10 +118,8 @@ TEST(RunCrowdBridge, StereoMapsOnAfterAShortBridgeWhereTheViewClearsOntoNewGroun
   const auto seq = tmp / "near";
   const auto synth = synth_crowd(seq, "near", "8", {"--stereo"}, "7");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  const auto out = tmp / "run";
-  const auto run = run_sequential(seq, out);
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  const auto doc = run_json(seq, tmp / "run");
+  ASSERT_FALSE(doc.is_null());
   const auto& summary = doc["summary"];
   // Keyframes made from a bridged pose once the filter took less than half the keypoints (the view clear).
   int resumed_in_clear_view = 0;
@@ -142,10 +153,8 @@ TEST(RunCrowdBridge, StereoBlackoutBridgesOnUntilTheFrameHasDepthToMapOn) {
   const auto synth = synth_crowd(seq, "blackout", "8", {"--stereo"});
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const int last_covered = nlohmann::json::parse(crowdslam::test::read_text(seq / "synth.json"))["blackout_frames"][1];
-  const auto out = tmp / "run";
-  const auto run = run_sequential(seq, out, {"--detector", "yolox"});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  const auto doc = run_json(seq, tmp / "run", {"--detector", "yolox"});
+  ASSERT_FALSE(doc.is_null());
   // After the blackout: bridged frames whose view has cleared (the filter took less than half the
   // keypoints) but that stereo found (almost) no depth in; never keyframes.
   int bridged_without_depth = 0;
@@ -182,10 +191,8 @@ TEST(RunCrowdBridge, RgbdBlackoutTheDetectorMissesIsBridgedByDepthInOneMap) {
   const auto planned = nlohmann::json::parse(crowdslam::test::read_text(seq / "synth.json"))["blackout_frames"];
   const int first = planned[0].get<int>();
   const int last = planned[1].get<int>();
-  const auto out = tmp / "run";
-  const auto run = run_sequential(seq, out);
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  const auto doc = run_json(seq, tmp / "run");
+  ASSERT_FALSE(doc.is_null());
   EXPECT_EQ(doc["summary"]["map_resets"].get<int>(), 0);
   int covered = 0;
   int covered_bridged = 0;
@@ -229,10 +236,8 @@ TEST(RunCrowdBridge, RgbdFramesTheFilterLeavesTooLittleAreTakenBackByTheMapsPoin
   const auto seq = tmp / "crowd";
   const auto synth = synth_crowd(seq, "passing", "16");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  const auto out = tmp / "run";
-  const auto run = run_sequential(seq, out);
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  const auto doc = run_json(seq, tmp / "run");
+  ASSERT_FALSE(doc.is_null());
   const auto& summary = doc["summary"];
   EXPECT_EQ(summary["map_resets"].get<int>(), 0);
   EXPECT_EQ(summary["bridged_frames"].get<int>(), 0);
@@ -250,13 +255,9 @@ TEST(RunCrowdBridge, RgbdFramesTheFilterLeavesTooLittleAreTakenBackByTheMapsPoin
   EXPECT_LT(summary["ate_rmse_m"].get<double>(), 0.015);  // 0.0114 m (0.0091 m with the bridged frames)
 
   // Without box keypoints ("monocular": monocular runs only) those frames are bridged.
-  const auto settings = tmp / "without.yaml";
-  crowdslam::test::write_text(settings, crowdslam::test::read_text(seq / "settings.yaml") +
-                                            "\nPeopleFilter.static_in_boxes: \"monocular\"\n");
-  const auto without_out = tmp / "without";
-  const auto without = run_sequential(seq, without_out, {"--settings", settings.string()});
-  ASSERT_EQ(without.exit_code, 0) << without.err;
-  const auto without_doc = nlohmann::json::parse(crowdslam::test::read_text(without_out / "run.json"));
+  const auto without_doc =
+      run_json(seq, tmp / "without", settings_with(seq, tmp / "without.yaml", "PeopleFilter.static_in_boxes: \"monocular\"\n"));
+  ASSERT_FALSE(without_doc.is_null());
   EXPECT_GE(without_doc["summary"]["bridged_frames"].get<int>(), rescued);
 }
 
@@ -274,10 +275,8 @@ TEST(RunCrowdBridge, MonocularReanchorsWhileBridgedOntoAViewTheMapNeverSaw) {
   const auto synth = synth_crowd(seq, "standing", "30");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const auto out = tmp / "run";
-  const auto run =
-      run_sequential(seq, out, {"--detections", (seq / "people_gt.txt").string(), "--sensor", "mono"});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto doc = nlohmann::json::parse(crowdslam::test::read_text(out / "run.json"));
+  const auto doc = run_json(seq, out, {"--detections", (seq / "people_gt.txt").string(), "--sensor", "mono"});
+  ASSERT_FALSE(doc.is_null());
   const auto& summary = doc["summary"];
   EXPECT_EQ(summary["map_resets"].get<int>(), 0);
   int reanchored_in_bridge = 0;
