@@ -12,11 +12,9 @@
 // map matches, or with depth the last frame's box keypoints landing where the pose says) is released and
 // mapped; nothing new in the map is made of any other box keypoint (Frame::in_box;
 // Tracker::create_new_keyframe and update_last_frame leave them out).
-#include <cmath>
 #include <unordered_map>
 #include <unordered_set>
 
-#include "crowdslam/geometry/se3.h"
 #include "crowdslam/map/map_point.h"
 #include "crowdslam/match/orb_matcher.h"
 #include "crowdslam/tracking/pose_refinement.h"
@@ -67,18 +65,6 @@ int release_static_boxes(map::Frame& frame, const std::vector<int>& box_of, cons
 }
 
 }  // namespace
-
-bool Tracker::within_rescue_gate(const geometry::SE3& cam_from_world, const geometry::SE3& predicted) const {
-  // Camera centres and viewing rotations compared, as agrees_with_bridge does.
-  const geometry::SE3 world_from_cam = cam_from_world.inverse();
-  const geometry::SE3 world_from_predicted = predicted.inverse();
-  const double metres = (world_from_cam.translation() - world_from_predicted.translation()).norm();
-  const double degrees =
-      geometry::rotation_angle(world_from_predicted.rotation_matrix().transpose() * world_from_cam.rotation_matrix()) *
-      180.0 / M_PI;
-  return (options_.box_rescue_gate_m <= 0 || metres <= options_.box_rescue_gate_m) &&
-         (options_.box_rescue_gate_deg <= 0 || degrees <= options_.box_rescue_gate_deg);
-}
 
 std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, bool tracked,
                                                       const BoxKeypoints& boxes, int& static_boxes,
@@ -154,7 +140,12 @@ std::optional<map::Frame> Tracker::with_box_keypoints(const map::Frame& frame, b
   // Tracked: the box keypoints must not lose what the filtered frame had; failed: as many inliers as a
   // pose from a new set of matches needs (ORB-SLAM's 50 after relocalisation; 30 in monocular).
   if (tracked ? after < before : after < options_.box_rescue_min_inliers) return std::nullopt;
-  if (!tracked && !within_rescue_gate(*full.cam_from_world, *pose)) return std::nullopt;
+  if (!tracked) {  // the pose from box keypoints near the motion model's (box_rescue_gate_*)
+    const PoseGap gap = pose_gap(*full.cam_from_world, *pose);
+    if ((options_.box_rescue_gate_m > 0 && gap.metres > options_.box_rescue_gate_m) ||
+        (options_.box_rescue_gate_deg > 0 && gap.degrees > options_.box_rescue_gate_deg))
+      return std::nullopt;
+  }
   std::vector<int8_t> flow(full.size(), 0);
   box_flow_evidence(full, flow);
   static_boxes = options_.box_release ? release_static_boxes(full, boxes.box_of, disagrees, flow) : 0;

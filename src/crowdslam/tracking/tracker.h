@@ -338,9 +338,13 @@ class Tracker {
   // With depth: whether the frame's pose, found after bridged frames, is within what the bridge's motion
   // can have drifted since its anchor (TrackerOptions::bridge_gate_*).
   [[nodiscard]] bool agrees_with_bridge(const map::Frame& frame, const BridgeMotion& motion) const;
-  // Whether a pose from box keypoints is within TrackerOptions::box_rescue_gate_* of the motion model's
-  // `predicted` pose (box_keypoints.cpp).
-  [[nodiscard]] bool within_rescue_gate(const geometry::SE3& cam_from_world, const geometry::SE3& predicted) const;
+  // How far a pose's camera centre (m) and viewing direction (degrees) lie from a predicted pose's (the
+  // bridge's gate, the box rescue's gate).
+  struct PoseGap {
+    double metres = 0;
+    double degrees = 0;
+  };
+  [[nodiscard]] static PoseGap pose_gap(const geometry::SE3& cam_from_world, const geometry::SE3& predicted);
   // On from the last frame at `velocity` (its velocity when the frame came).
   [[nodiscard]] std::optional<BridgeMotion> last_frame_motion(const map::Frame& frame,
                                                               const std::optional<geometry::SE3>& velocity) const;

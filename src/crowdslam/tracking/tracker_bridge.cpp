@@ -110,19 +110,21 @@ bool Tracker::refine_predicted_pose(map::Frame& frame) const {
   return true;
 }
 
+Tracker::PoseGap Tracker::pose_gap(const geometry::SE3& cam_from_world, const geometry::SE3& predicted) {
+  // Camera centres and viewing rotations compared (cam_from_world: the centre is -R^T t).
+  const geometry::SE3 world_from_cam = cam_from_world.inverse();
+  const geometry::SE3 world_from_predicted = predicted.inverse();
+  return {(world_from_cam.translation() - world_from_predicted.translation()).norm(),
+          geometry::rotation_angle(world_from_predicted.rotation_matrix().transpose() * world_from_cam.rotation_matrix()) *
+              180.0 / M_PI};
+}
+
 bool Tracker::agrees_with_bridge(const map::Frame& frame, const BridgeMotion& motion) const {
   if (!(options_.bridge_gate_base_m > 0) || !frame.cam_from_world) return true;
   const double elapsed_s = std::max(0.0, frame.timestamp_s - motion.anchor_s);
-  const geometry::SE3 predicted = motion.at(frame.timestamp_s);
-  // Camera centres and viewing rotations compared (cam_from_world: the centre is -R^T t).
-  const geometry::SE3 world_from_cam = frame.cam_from_world->inverse();
-  const geometry::SE3 world_from_predicted = predicted.inverse();
-  const double distance_m = (world_from_cam.translation() - world_from_predicted.translation()).norm();
-  const double angle_deg =
-      geometry::rotation_angle(world_from_predicted.rotation_matrix().transpose() * world_from_cam.rotation_matrix()) *
-      180.0 / M_PI;
-  return distance_m <= options_.bridge_gate_base_m + options_.bridge_gate_m_per_s * elapsed_s &&
-         angle_deg <= options_.bridge_gate_base_deg + options_.bridge_gate_deg_per_s * elapsed_s;
+  const PoseGap gap = pose_gap(*frame.cam_from_world, motion.at(frame.timestamp_s));
+  return gap.metres <= options_.bridge_gate_base_m + options_.bridge_gate_m_per_s * elapsed_s &&
+         gap.degrees <= options_.bridge_gate_base_deg + options_.bridge_gate_deg_per_s * elapsed_s;
 }
 
 size_t Tracker::map_points_near_keypoints(const map::Frame& frame) const {
